@@ -1,0 +1,620 @@
+// ---------------------------------------------------------------------
+// PeriDEAL benchmark: explicit linear PD diffusion on uniform lattices.
+//
+// For each case (dimension, horizon ratio m = delta/dx, node count) it
+// times Discretization::setup() and the DiffusionOperator construction,
+// then forward Euler steps
+//     C.update_ghost_values(); op.apply(C, rate); C.add(dt, rate);
+// with dt = 0.5 * op.critical_time_step(), and prints `key: value` lines:
+// bond updates per second per core (global bonds x steps / (wall seconds x
+// ranks)), bytes per bond, setup times. It also times prototype variants of
+// the apply loop (same data, checked against op.apply) so that faster
+// loops can be measured before they go into source/models/diffusion.cc.
+//
+// Usage: diffusion_benchmark [options]
+//   --case NAME      2d_m3 | 2d_m12 | 3d_m3 | 3d_m12 (preset; repeatable)
+//   --dim D --m M    a custom case (with --nodes)
+//   --nodes N        target number of nodes (a cube/square of side N^(1/dim))
+//   --steps S        timed steps per loop (0: enough for --seconds)
+//   --seconds T      target wall time of each timed loop (default 1)
+//   --layer          add a volume constraint layer of thickness delta
+//   --no-prototypes  skip the prototype apply loops
+//   --profile-apply S  only run S apply() calls after setup (for profilers)
+// Without --case/--dim it runs the four presets and prints the aggregate
+// setup_seconds_per_million_bonds.
+// ---------------------------------------------------------------------
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <perideal/discretization/discretization.h>
+#include <perideal/discretization/domain.h>
+#include <perideal/models/diffusion.h>
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace PeriDEAL;
+
+namespace
+{
+  struct Case
+  {
+    std::string name; // key prefix after "diffusion_"
+    unsigned int dim   = 2;
+    unsigned int m     = 3;
+    double       nodes = 1e6;
+  };
+
+  struct Options
+  {
+    std::vector<Case> cases;
+    unsigned int      steps         = 0;
+    double            seconds       = 1.;
+    bool              layer         = false;
+    bool              prototypes    = true;
+    unsigned int      profile_apply = 0;
+  };
+
+  Case
+  preset(const std::string &name)
+  {
+    // 2D: 1000 x 1000 = 1e6 nodes for both horizons (2D m=12: ~4.8e8
+    // bonds, ~2 GB of column indices). 3D m=3: 100^3 = 1e6 nodes. 3D m=12
+    // has ~8000 bonds per interior node and a horizon of 12.5 dx, so a box
+    // that fits in memory is mostly boundary rows (which carry their own
+    // weight tables): 32^3 nodes, ~1.4e8 bonds.
+    if (name == "2d_m3")
+      return {name, 2, 3, 1e6};
+    if (name == "2d_m12")
+      return {name, 2, 12, 1e6};
+    if (name == "3d_m3")
+      return {name, 3, 3, 1e6};
+    if (name == "3d_m12")
+      return {name, 3, 12, 32768};
+    throw std::runtime_error("unknown case " + name + " (2d_m3, 2d_m12, 3d_m3, 3d_m12)");
+  }
+
+  /** VmRSS and VmHWM of this process in bytes. */
+  std::pair<double, double>
+  rss_bytes()
+  {
+    std::ifstream in("/proc/self/status");
+    std::string   line;
+    double        rss = 0., hwm = 0.;
+    while (std::getline(in, line))
+      {
+        std::istringstream s(line);
+        std::string        key;
+        double             kb;
+        s >> key >> kb;
+        if (key == "VmRSS:")
+          rss = kb * 1024.;
+        else if (key == "VmHWM:")
+          hwm = kb * 1024.;
+      }
+    return {rss, hwm};
+  }
+
+  // -------------------------------------------------------------------
+  // Prototype apply loops. All compute rate_i = kappa (sum_k w_k C_j -
+  // rowsum_i C_i) on the same Neighborhood as DiffusionOperator::apply.
+  // -------------------------------------------------------------------
+  struct KernelData
+  {
+    const double        *c;
+    double              *r;
+    const std::int32_t  *col;
+    const std::uint64_t *row_start;
+    const std::uint64_t *table;
+    const double        *gw;      // geometric weights per table entry
+    const double        *row_sum; // per owned row
+    double               kappa;
+    unsigned int         n;
+    unsigned int         stencil; // size of the shared interior slice (table 0)
+  };
+
+  // (a) The library loop, compiled here: checks that this TU's flags match.
+  void
+  apply_baseline(const KernelData &d)
+  {
+    for (unsigned int i = 0; i < d.n; ++i)
+      {
+        const std::int32_t *ci = d.col + d.row_start[i];
+        const double       *wi = d.gw + d.table[i];
+        const unsigned int  m  = d.row_start[i + 1] - d.row_start[i];
+        double              s  = 0.;
+#pragma omp simd reduction(+ : s)
+        for (unsigned int k = 0; k < m; ++k)
+          s += wi[k] * d.c[ci[k]];
+        d.r[i] = d.kappa * (s - d.row_sum[i] * d.c[i]);
+      }
+  }
+
+  // (b) Scalar loads (no gather instructions), four accumulators.
+  __attribute__((optimize("no-tree-vectorize"))) void
+  apply_scalar(const KernelData &d)
+  {
+    for (unsigned int i = 0; i < d.n; ++i)
+      {
+        const std::int32_t *ci = d.col + d.row_start[i];
+        const double       *wi = d.gw + d.table[i];
+        const unsigned int  m  = d.row_start[i + 1] - d.row_start[i];
+        double              s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
+        unsigned int        k  = 0;
+        for (; k + 4 <= m; k += 4)
+          {
+            s0 += wi[k] * d.c[ci[k]];
+            s1 += wi[k + 1] * d.c[ci[k + 1]];
+            s2 += wi[k + 2] * d.c[ci[k + 2]];
+            s3 += wi[k + 3] * d.c[ci[k + 3]];
+          }
+        for (; k < m; ++k)
+          s0 += wi[k] * d.c[ci[k]];
+        d.r[i] = d.kappa * ((s0 + s1) + (s2 + s3) - d.row_sum[i] * d.c[i]);
+      }
+  }
+
+  // (c) Scalar loads, two rows at a time where both are interior rows:
+  // the shared stencil weights are loaded once for two rows and the two
+  // rows give two independent FMA chains per weight.
+  __attribute__((optimize("no-tree-vectorize"))) void
+  apply_scalar_2row(const KernelData &d)
+  {
+    const unsigned int S = d.stencil;
+    unsigned int       i = 0;
+    auto               one_row = [&](const unsigned int i) {
+      const std::int32_t *ci = d.col + d.row_start[i];
+      const double       *wi = d.gw + d.table[i];
+      const unsigned int  m  = d.row_start[i + 1] - d.row_start[i];
+      double              s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
+      unsigned int        k  = 0;
+      for (; k + 4 <= m; k += 4)
+        {
+          s0 += wi[k] * d.c[ci[k]];
+          s1 += wi[k + 1] * d.c[ci[k + 1]];
+          s2 += wi[k + 2] * d.c[ci[k + 2]];
+          s3 += wi[k + 3] * d.c[ci[k + 3]];
+        }
+      for (; k < m; ++k)
+        s0 += wi[k] * d.c[ci[k]];
+      d.r[i] = d.kappa * ((s0 + s1) + (s2 + s3) - d.row_sum[i] * d.c[i]);
+    };
+    for (; i + 1 < d.n; i += 2)
+      {
+        const bool regular = d.table[i] == 0 && d.table[i + 1] == 0 &&
+                             d.row_start[i + 1] - d.row_start[i] == S &&
+                             d.row_start[i + 2] - d.row_start[i + 1] == S;
+        if (!regular)
+          {
+            one_row(i);
+            one_row(i + 1);
+            continue;
+          }
+        const std::int32_t *a  = d.col + d.row_start[i];
+        const std::int32_t *b  = a + S;
+        const double       *w  = d.gw;
+        double              a0 = 0., a1 = 0., b0 = 0., b1 = 0.;
+        unsigned int        k  = 0;
+        for (; k + 2 <= S; k += 2)
+          {
+            a0 += w[k] * d.c[a[k]];
+            b0 += w[k] * d.c[b[k]];
+            a1 += w[k + 1] * d.c[a[k + 1]];
+            b1 += w[k + 1] * d.c[b[k + 1]];
+          }
+        for (; k < S; ++k)
+          {
+            a0 += w[k] * d.c[a[k]];
+            b0 += w[k] * d.c[b[k]];
+          }
+        d.r[i]     = d.kappa * (a0 + a1 - d.row_sum[i] * d.c[i]);
+        d.r[i + 1] = d.kappa * (b0 + b1 - d.row_sum[i + 1] * d.c[i + 1]);
+      }
+    for (; i < d.n; ++i)
+      one_row(i);
+  }
+
+#ifdef __AVX512F__
+  // (d) Explicit AVX-512 gathers: 8 bonds per gather, masked tail (no
+  // scalar remainder loop), two accumulators.
+  void
+  apply_avx512(const KernelData &d)
+  {
+    for (unsigned int i = 0; i < d.n; ++i)
+      {
+        const std::int32_t *ci = d.col + d.row_start[i];
+        const double       *wi = d.gw + d.table[i];
+        const unsigned int  m  = d.row_start[i + 1] - d.row_start[i];
+        __m512d             s0 = _mm512_setzero_pd(), s1 = _mm512_setzero_pd();
+        unsigned int        k  = 0;
+        for (; k + 16 <= m; k += 16)
+          {
+            const __m256i j0 = _mm256_loadu_si256((const __m256i *)(ci + k));
+            const __m256i j1 = _mm256_loadu_si256((const __m256i *)(ci + k + 8));
+            s0 = _mm512_fmadd_pd(_mm512_loadu_pd(wi + k), _mm512_i32gather_pd(j0, d.c, 8), s0);
+            s1 = _mm512_fmadd_pd(_mm512_loadu_pd(wi + k + 8),
+                                 _mm512_i32gather_pd(j1, d.c, 8), s1);
+          }
+        for (; k < m; k += 8)
+          {
+            const __mmask8 mask = m - k >= 8 ? 0xff : (__mmask8)((1u << (m - k)) - 1);
+            const __m256i  j    = _mm256_maskz_loadu_epi32(mask, ci + k);
+            const __m512d  w    = _mm512_maskz_loadu_pd(mask, wi + k);
+            const __m512d  v =
+              _mm512_mask_i32gather_pd(_mm512_setzero_pd(), mask, j, d.c, 8);
+            s0 = _mm512_fmadd_pd(w, v, s0);
+          }
+        const double s = _mm512_reduce_add_pd(_mm512_add_pd(s0, s1));
+        d.r[i]         = d.kappa * (s - d.row_sum[i] * d.c[i]);
+      }
+  }
+#endif
+
+  // (e) Roofline probe, not a valid operator: the same row loop streaming
+  // col and w but reading C contiguously (c[i + k]) instead of c[col[k]],
+  // i.e. the cost without the indirect loads. C must be padded.
+  void
+  probe_no_gather(const KernelData &d, std::int64_t &checksum)
+  {
+    std::int64_t t = 0;
+    for (unsigned int i = 0; i < d.n; ++i)
+      {
+        const std::int32_t *ci = d.col + d.row_start[i];
+        const double       *wi = d.gw + d.table[i];
+        const unsigned int  m  = d.row_start[i + 1] - d.row_start[i];
+        const double       *cc = d.c + i;
+        double              s  = 0.;
+        std::int32_t        u  = 0;
+#pragma omp simd reduction(+ : s, u)
+        for (unsigned int k = 0; k < m; ++k)
+          {
+            s += wi[k] * cc[k];
+            u += ci[k];
+          }
+        t += u;
+        d.r[i] = d.kappa * (s - d.row_sum[i] * d.c[i]);
+      }
+    checksum += t;
+  }
+
+  template <typename F>
+  double
+  time_loop(const MPI_Comm comm, const unsigned int steps, F &&f)
+  {
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    for (unsigned int s = 0; s < steps; ++s)
+      f();
+    const double t = MPI_Wtime() - t0;
+    return Utilities::MPI::max(t, comm);
+  }
+
+  struct CaseResult
+  {
+    double setup_seconds = 0.;
+    double bonds         = 0.;
+  };
+
+  template <int dim>
+  CaseResult
+  run_case(const Case &c, const Options &opt, const MPI_Comm comm)
+  {
+    const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
+    const unsigned int n_ranks = Utilities::MPI::n_mpi_processes(comm);
+    const std::string  prefix  = "diffusion_" + c.name + "_";
+    auto               print   = [&](const std::string &key, const double value) {
+      if (rank == 0)
+        std::printf("%s%s: %.6g\n", prefix.c_str(), key.c_str(), value);
+    };
+    auto print_int = [&](const std::string &key, const double value) {
+      if (rank == 0)
+        std::printf("%s%s: %.0f\n", prefix.c_str(), key.c_str(), value);
+    };
+    auto flush = [&] {
+      if (rank == 0)
+        std::fflush(stdout);
+    };
+
+    // A cube [0, 1]^dim with n nodes per direction (vertex lattice).
+    const unsigned int n_side = std::max(2., std::round(std::pow(c.nodes, 1. / dim)));
+    LatticeParameters  lp;
+    lp.dx              = 1. / (n_side - 1);
+    lp.delta           = c.m * lp.dx;
+    lp.partial_volume  = true;
+    lp.cell_centered   = false;
+    lp.layer_thickness = opt.layer ? lp.delta : 0.;
+    Point<dim> upper;
+    for (unsigned int d = 0; d < dim; ++d)
+      upper[d] = 1.;
+    BoxDomain<dim> box(Point<dim>(), upper);
+
+    DiffusionModelParameters mp;
+    mp.type              = "diffusion";
+    mp.omega             = InfluenceFunction::constant;
+    mp.exponent          = 1.; // q = 1 (J_q convention)
+    mp.micro_diffusivity = 0.;
+    mp.diffusivity       = 1.;
+
+    const double rss_before = rss_bytes().first;
+    MPI_Barrier(comm);
+    double                    t0 = MPI_Wtime();
+    Discretization<dim>       disc(comm);
+    disc.setup(box, lp);
+    const double t_disc = Utilities::MPI::max(MPI_Wtime() - t0, comm);
+    MPI_Barrier(comm);
+    t0 = MPI_Wtime();
+    DiffusionOperator<dim> op(disc, mp);
+    const double t_op = Utilities::MPI::max(MPI_Wtime() - t0, comm);
+
+    PeriDEAL::Vector C, rate;
+    disc.initialize_vector(C);
+    disc.initialize_vector(rate);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        double v = 1.;
+        for (unsigned int d = 0; d < dim; ++d)
+          v *= 0.5 + 0.5 * std::cos(3.14159265358979 * disc.position[i][d]);
+        C.local_element(i) = 1. + v;
+      }
+    C.update_ghost_values();
+    const auto   rss_after = rss_bytes();
+    const auto  &nb        = disc.neighborhood;
+    const double bonds     = double(disc.n_global_bonds());
+    const double nodes     = double(disc.n_global());
+
+    std::array<double, 3> phases;
+    for (unsigned int p = 0; p < 3; ++p)
+      phases[p] = Utilities::MPI::max(disc.setup_seconds[p], comm);
+
+    // Memory: the CSR, the operator's weight tables (geometric_weight has
+    // one entry per table entry, row_sum one per owned row), two vectors.
+    const double nb_bytes  = Utilities::MPI::sum(double(nb.memory_consumption()), comm);
+    const double op_bytes  = Utilities::MPI::sum(
+      double(nb.bond_length.size() * sizeof(double) + disc.n_owned() * sizeof(double)), comm);
+    const double vec_bytes = Utilities::MPI::sum(
+      2. * double(disc.n_owned() + disc.n_ghost()) * sizeof(double), comm);
+    const double rss_delta = Utilities::MPI::sum(rss_after.first - rss_before, comm);
+    const double rss_peak  = Utilities::MPI::sum(rss_after.second, comm);
+    const double n_regular = Utilities::MPI::sum(double(nb.n_regular_rows), comm);
+    const double table_entries = Utilities::MPI::sum(double(nb.bond_length.size()), comm);
+
+    print_int("nodes", nodes);
+    print_int("bonds", bonds);
+    print_int("stencil_size", nb.stencil_size);
+    print("bonds_per_node", bonds / nodes);
+    print("regular_row_fraction", n_regular / nodes);
+    print("table_entries_per_bond", table_entries / bonds);
+    print("setup_lattice_seconds", phases[0]);
+    print("setup_ghost_seconds", phases[1]);
+    print("setup_search_csr_seconds", phases[2]);
+    print("setup_operator_seconds", t_op);
+    print("setup_seconds", t_disc + t_op);
+    print("setup_seconds_per_million_bonds", (t_disc + t_op) / (bonds / 1e6));
+    print("neighborhood_bytes_per_bond", nb_bytes / bonds);
+    print("operator_bytes_per_bond", op_bytes / bonds);
+    print("vector_bytes_per_bond", vec_bytes / bonds);
+    print("bytes_per_bond", (nb_bytes + op_bytes + vec_bytes) / bonds);
+    print("rss_bytes_per_bond", rss_delta / bonds);
+    print("peak_rss_bytes_per_bond", rss_peak / bonds);
+    if (c.name == "3d_m3" && rank == 0)
+      std::printf("diffusion_3d_bytes_per_bond: %.6g\n",
+                  (nb_bytes + op_bytes + vec_bytes) / bonds);
+    flush();
+
+    if (opt.profile_apply > 0)
+      {
+        for (unsigned int s = 0; s < opt.profile_apply; ++s)
+          op.apply(C, rate);
+        return {t_disc + t_op, bonds};
+      }
+
+    const double dt = 0.5 * op.critical_time_step();
+    print("dt", dt);
+
+    // Warm-up step, which also calibrates the number of steps.
+    double t_one = time_loop(comm, 1, [&] {
+      C.update_ghost_values();
+      op.apply(C, rate);
+      C.add(dt, rate);
+    });
+    unsigned int steps = opt.steps;
+    if (steps == 0)
+      steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
+    steps = Utilities::MPI::max(steps, comm);
+    print_int("steps", steps);
+
+    const double bond_updates = bonds * steps;
+    auto         rate_of      = [&](const double seconds) {
+      return bond_updates / (seconds * n_ranks);
+    };
+
+    const double t_step = time_loop(comm, steps, [&] {
+      C.update_ghost_values();
+      op.apply(C, rate);
+      C.add(dt, rate);
+    });
+    print("step_seconds", t_step / steps);
+    print("bond_updates_per_s_per_core", rate_of(t_step));
+    flush();
+
+    C.update_ghost_values();
+    const double t_apply = time_loop(comm, steps, [&] { op.apply(C, rate); });
+    print("apply_seconds", t_apply / steps);
+    print("apply_bond_updates_per_s_per_core", rate_of(t_apply));
+    print("ghost_update_seconds",
+          time_loop(comm, steps, [&] { C.update_ghost_values(); }) / steps);
+    print("vector_add_seconds", time_loop(comm, steps, [&] { C.add(0., rate); }) / steps);
+    flush();
+
+    if (!opt.prototypes)
+      return {t_disc + t_op, bonds};
+
+    // The same weights as the operator (its arrays are private): omega
+    // evaluated at min(r, delta) times beta V.
+    ScalarKernel shape;
+    shape.dim      = dim;
+    shape.omega    = mp.omega;
+    shape.exponent = mp.exponent;
+    shape.delta    = lp.delta;
+    shape.constant = 1.;
+    std::vector<double> gw(nb.bond_length.size()), row_sum(disc.n_owned());
+    for (std::size_t t = 0; t < gw.size(); ++t)
+      gw[t] = shape(std::min(nb.bond_length[t], shape.delta)) * nb.bond_weight[t];
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        double s = 0.;
+        for (std::uint64_t k = 0; k < nb.row_start[i + 1] - nb.row_start[i]; ++k)
+          s += gw[nb.table_start[i] + k];
+        row_sum[i] = s;
+      }
+    const double kappa = op.kernel().constant;
+
+    // Reference result of the library.
+    op.apply(C, rate);
+    std::vector<double> reference(rate.begin(), rate.begin() + disc.n_owned());
+    double              ref_norm = 0.;
+    for (const double v : reference)
+      ref_norm = std::max(ref_norm, std::abs(v));
+    ref_norm = Utilities::MPI::max(ref_norm, comm);
+
+    std::vector<double> out(disc.n_owned() + 1);
+    KernelData          d{C.begin(),
+                 out.data(),
+                 nb.col.data(),
+                 nb.row_start.data(),
+                 nb.table_start.data(),
+                 gw.data(),
+                 row_sum.data(),
+                 kappa,
+                 disc.n_owned(),
+                 nb.stencil_size};
+
+    auto run_variant = [&](const std::string &name, const std::function<void()> &f) {
+      f();
+      double err = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        err = std::max(err, std::abs(out[i] - reference[i]));
+      err = Utilities::MPI::max(err, comm) / std::max(ref_norm, 1e-300);
+      const double t = time_loop(comm, steps, f);
+      print("proto_" + name + "_bond_updates_per_s_per_core", rate_of(t));
+      print("proto_" + name + "_speedup", t_apply / t);
+      print("proto_" + name + "_rel_error", err);
+      flush();
+    };
+    run_variant("baseline", [&] { apply_baseline(d); });
+    run_variant("scalar", [&] { apply_scalar(d); });
+    run_variant("scalar_2row", [&] { apply_scalar_2row(d); });
+#ifdef __AVX512F__
+    run_variant("avx512", [&] { apply_avx512(d); });
+#endif
+
+    // Roofline probe: contiguous C instead of the gather.
+    {
+      // No row is longer than the stencil.
+      std::vector<double> padded(disc.n_owned() + nb.stencil_size + 64, 1.);
+      KernelData   p  = d;
+      p.c             = padded.data();
+      std::int64_t cs = 0;
+      const double t  = time_loop(comm, steps, [&] { probe_no_gather(p, cs); });
+      print("probe_no_gather_bond_updates_per_s_per_core", rate_of(t));
+      if (cs == 42)
+        std::printf("#\n");
+      flush();
+    }
+    return {t_disc + t_op, bonds};
+  }
+
+  Options
+  parse(int argc, char **argv)
+  {
+    Options      opt;
+    Case         custom;
+    bool         have_custom = false;
+    for (int a = 1; a < argc; ++a)
+      {
+        const std::string arg  = argv[a];
+        auto              next = [&]() -> std::string {
+          if (a + 1 >= argc)
+            throw std::runtime_error("missing value after " + arg);
+          return argv[++a];
+        };
+        if (arg == "--case")
+          opt.cases.push_back(preset(next()));
+        else if (arg == "--dim")
+          custom.dim = std::stoi(next()), have_custom = true;
+        else if (arg == "--m")
+          custom.m = std::stoi(next()), have_custom = true;
+        else if (arg == "--nodes")
+          custom.nodes = std::stod(next()), have_custom = true;
+        else if (arg == "--steps")
+          opt.steps = std::stoi(next());
+        else if (arg == "--seconds")
+          opt.seconds = std::stod(next());
+        else if (arg == "--layer")
+          opt.layer = true;
+        else if (arg == "--no-prototypes")
+          opt.prototypes = false;
+        else if (arg == "--profile-apply")
+          opt.profile_apply = std::stoi(next());
+        else if (arg == "--help" || arg == "-h")
+          {
+            std::printf("see the header of contrib/benchmarks/diffusion_benchmark.cc\n");
+            std::exit(0);
+          }
+        else
+          throw std::runtime_error("unknown argument " + arg);
+      }
+    if (have_custom)
+      {
+        if (custom.dim < 2 || custom.dim > 3)
+          throw std::runtime_error("--dim must be 2 or 3");
+        custom.name = std::to_string(custom.dim) + "d_m" + std::to_string(custom.m);
+        opt.cases.push_back(custom);
+      }
+    if (opt.cases.empty())
+      for (const char *name : {"2d_m3", "2d_m12", "3d_m3", "3d_m12"})
+        opt.cases.push_back(preset(name));
+    return opt;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const MPI_Comm                   comm = MPI_COMM_WORLD;
+  try
+    {
+      const Options opt   = parse(argc, argv);
+      double        setup = 0., bonds = 0.;
+      for (const Case &c : opt.cases)
+        {
+          const CaseResult r = c.dim == 2 ? run_case<2>(c, opt, comm) : run_case<3>(c, opt, comm);
+          setup += r.setup_seconds;
+          bonds += r.bonds;
+        }
+      if (Utilities::MPI::this_mpi_process(comm) == 0)
+        {
+          std::printf("setup_seconds_per_million_bonds: %.6g\n", setup / (bonds / 1e6));
+          std::fflush(stdout);
+        }
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "diffusion_benchmark: " << e.what() << std::endl;
+      MPI_Abort(comm, 1);
+    }
+  return 0;
+}

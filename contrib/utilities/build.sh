@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Configure and build PeriDEAL (Release) into ${BUILD_DIR:-build}.
+set -euo pipefail
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build="${BUILD_DIR:-$top/build}"
+cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" > "$build.configure.log" 2>&1 \
+  || { cat "$build.configure.log"; exit 1; }
+cmake --build "$build" -j"$(nproc)"

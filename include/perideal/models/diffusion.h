@@ -1,0 +1,135 @@
+#ifndef perideal_models_diffusion_h
+#define perideal_models_diffusion_h
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+
+#include <perideal/base/kernel.h>
+#include <perideal/discretization/discretization.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  /**
+   * Parameters of the scalar PD transport models: linear PD diffusion
+   * (2.41)-(2.42) and the bi-material corrosion model (2.48)-(2.49) with the
+   * phase rule (2.79).
+   */
+  struct DiffusionModelParameters
+  {
+    /** "diffusion" or "corrosion". */
+    std::string type = "diffusion";
+    /** Influence function omega. */
+    InfluenceFunction omega = InfluenceFunction::constant;
+    /**
+     * Exponent of |xi| in the kernel denominator: q for J_q of (2.42), or
+     * n_d + 2q for the corrosion convention of (2.49) (set by the parser from
+     * 'Kernel convention').
+     */
+    double exponent = 2.;
+    /** Local diffusivity D; used to compute kappa when 'Micro-diffusivity' is 0. */
+    double diffusivity = 1.;
+    /** kappa; if > 0 it is used as given (the sources often state kappa). */
+    double micro_diffusivity = 0.;
+    /** Corrosion: kappa of liquid-liquid, solid-liquid and solid-solid bonds. */
+    double kappa_liquid = 1., kappa_interface = 0.1, kappa_solid = 0.;
+    /** Corrosion: saturation concentration C_sat of (2.79). */
+    double saturation = 0.85;
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    /** The caller has entered "Model". */
+    void
+    parse_parameters(ParameterHandler &prm, const unsigned int dim);
+  };
+
+  /**
+   * The standard-scheme PD transport operator (3.4)
+   * @f[ (L C)_i = \sum_{j \in F_i} \kappa_{ij} \, \omega(|\xi|) |\xi|^{-p}
+   *      \beta(\xi) V_j \, (C_j - C_i), @f]
+   * with kappa_ij constant (diffusion) or chosen by the phases of the bond's
+   * end points (corrosion: liquid-liquid, interface, solid-solid). Kernel
+   * weights share the Neighborhood's table layout, so interior rows use
+   * one stencil table.
+   */
+  template <int dim>
+  class DiffusionOperator
+  {
+  public:
+    /** Build the kernel weights for @p discretization. */
+    DiffusionOperator(const Discretization<dim>      &discretization,
+                      const DiffusionModelParameters &parameters);
+
+    /** The kernel (with kappa as its constant for linear diffusion). */
+    const ScalarKernel &
+    kernel() const
+    {
+      return scalar_kernel;
+    }
+
+    /** True for the bi-material corrosion model. */
+    bool
+    is_corrosion() const
+    {
+      return corrosion;
+    }
+
+    /**
+     * rate_i = (L C)_i for the owned nodes. @p C must have up-to-date ghost
+     * values. For corrosion, @p phase (1 solid, 0 liquid, ghosts up to date)
+     * selects kappa per bond; it is ignored for linear diffusion.
+     */
+    void
+    apply(const Vector &C, Vector &rate, const Vector *phase = nullptr) const;
+
+    /**
+     * Largest stable forward Euler step 1 / max_i sum_j |kappa_ij w_ij| from
+     * the Gershgorin bound on the discrete operator (003, eq. 16, here with
+     * beta and the actual bond coefficients). For corrosion the largest of
+     * the three kappas is used, which bounds every phase configuration.
+     */
+    double
+    critical_time_step() const;
+
+    /**
+     * Assemble the backward Euler matrix A = M/dt - L restricted to the
+     * interior rows (constrained rows are identity; couplings to constrained
+     * nodes are left out and must go to the right hand side through
+     * constrained_coupling()). Symmetric for equal node volumes.
+     */
+    void
+    assemble_backward_euler(const double                   dt,
+                            TrilinosWrappers::SparseMatrix &matrix,
+                            const Vector                   *phase = nullptr) const;
+
+    /**
+     * rhs_i += sum over constrained neighbours j of kappa_ij w_ij C_j, for the
+     * interior rows (the couplings assemble_backward_euler() left out).
+     */
+    void
+    add_constrained_coupling(const Vector &C, Vector &rhs, const Vector *phase = nullptr) const;
+
+    /** The bond coefficient kappa for end-point phases (0 liquid, 1 solid). */
+    double
+    bond_kappa(const bool solid_i, const bool solid_j) const
+    {
+      return kappa_table[2 * solid_i + solid_j];
+    }
+
+  private:
+    const Discretization<dim> &disc;
+    ScalarKernel               scalar_kernel;
+    bool                       corrosion;
+    std::array<double, 4>      kappa_table;
+    /** omega(r) r^-p beta V per table entry of the Neighborhood. */
+    std::vector<double> geometric_weight;
+    /** Row sums of geometric_weight. */
+    std::vector<double> row_sum;
+  };
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,201 @@
+// The `perideal` driver: one parameter file in, one run out.
+//
+//   perideal FILE.prm                 run (also under mpirun -np N)
+//   perideal --print-parameters       every parameter with documentation and range
+//   perideal --resume FILE.prm        resume from the checkpoint in the output directory
+//   perideal --stop-after-steps N FILE.prm   stop after N steps (tests of restart)
+//   perideal --compare A.csv B.csv TOL  compare two node tables (exit 1 if max diff > TOL)
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/utilities.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/io/checkpoint.h>
+#include <perideal/time_stepping/diffusion_solver.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+using namespace dealii;
+using namespace PeriDEAL;
+
+namespace
+{
+  void
+  declare_all(ParameterHandler &prm)
+  {
+    prm.declare_entry("Dimension", "2", Patterns::Integer(1, 3),
+                      "Spatial dimension of the run (1, 2 or 3).");
+    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion"),
+                      "The problem class; PD diffusion and bi-material corrosion "
+                      "(Model/Type) in this version.");
+    // The entries do not depend on the dimension; declare them once.
+    DiffusionRunParameters<2>::declare_parameters(prm);
+  }
+
+  // A PNG of the time series with gnuplot, if it is installed.
+  void
+  plot_time_series(const std::string &dir, const bool corrosion, const bool has_error)
+  {
+    if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
+      {
+        std::cout << "(gnuplot not found: no PNG plot written)" << std::endl;
+        return;
+      }
+    const std::string script = dir + "/plot.gp";
+    std::ofstream     gp(script);
+    gp << "set terminal pngcairo size 900,600 noenhanced\n"
+       << "set output '" << dir << "/time_series.png'\n"
+       << "set datafile separator ','\nset key autotitle columnhead\n"
+       << "set xlabel 'time'\nset grid\n";
+    if (corrosion)
+      gp << "set ylabel 'solid volume'\nset y2label 'Pi = sum C^2 V'\nset y2tics\n"
+         << "plot '" << dir << "/time_series.csv' using 1:4 with lines lw 2, '' using 1:3 axes x1y2 with lines lw 2\n";
+    else if (has_error)
+      gp << "set ylabel 'relative l2 error (3.79)'\nset logscale y\n"
+         << "plot '" << dir << "/time_series.csv' using 1:5 with lines lw 2\n";
+    else
+      gp << "set ylabel 'mass, Pi'\n"
+         << "plot '" << dir << "/time_series.csv' using 1:2 with lines lw 2, '' using 1:3 with lines lw 2\n";
+    gp.close();
+    if (std::system(("gnuplot '" + script + "' 2> /dev/null").c_str()) == 0)
+      std::cout << "Plot: " << dir << "/time_series.png" << std::endl;
+  }
+
+  template <int dim>
+  void
+  run(ParameterHandler &prm, const bool resume, const unsigned int stop_after)
+  {
+    DiffusionRunParameters<dim> parameters;
+    parameters.parse_parameters(prm);
+    if (resume)
+      parameters.resume = true;
+
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    if (Utilities::MPI::this_mpi_process(comm) == 0)
+      {
+        std::filesystem::create_directories(parameters.output_directory);
+        const std::string used = parameters.output_directory + "/parameters.prm";
+        std::ofstream     out(used + ".tmp");
+        prm.print_parameters(out, ParameterHandler::PRM);
+        out.close();
+        std::filesystem::rename(used + ".tmp", used);
+      }
+    MPI_Barrier(comm);
+
+    DiffusionSolver<dim> solver(comm, parameters);
+    solver.setup();
+    solver.run(stop_after);
+
+    const auto d = solver.diagnostics();
+    if (Utilities::MPI::this_mpi_process(comm) == 0)
+      {
+        std::cout << "Final: t = " << d.time << ", mass = " << d.mass << ", Pi = " << d.pi;
+        if (solver.get_operator().is_corrosion())
+          std::cout << ", solid volume = " << d.solid_volume;
+        if (!parameters.exact_solution.empty())
+          std::cout << ", relative l2 error = " << d.error;
+        std::cout << std::endl;
+        if (solver.step() == solver.n_steps())
+          plot_time_series(parameters.output_directory,
+                           solver.get_operator().is_corrosion(),
+                           !parameters.exact_solution.empty());
+      }
+    solver.timer().print_wall_time_statistics(comm);
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  try
+    {
+      Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+      const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+
+      ParameterHandler prm;
+      declare_all(prm);
+
+      bool         resume     = false;
+      unsigned int stop_after = std::numeric_limits<unsigned int>::max();
+      std::string  file;
+      for (int a = 1; a < argc; ++a)
+        {
+          const std::string arg = argv[a];
+          if (arg == "--print-parameters")
+            {
+              if (root)
+                prm.print_parameters(std::cout,
+                                     ParameterHandler::PRM |
+                                       ParameterHandler::KeepDeclarationOrder);
+              return 0;
+            }
+          else if (arg == "--resume")
+            resume = true;
+          else if (arg == "--stop-after-steps" && a + 1 < argc)
+            stop_after = std::stoul(argv[++a]);
+          else if (arg == "--compare" && a + 3 < argc)
+            {
+              const double diff = compare_node_tables(argv[a + 1], argv[a + 2]);
+              const double tol  = std::stod(argv[a + 3]);
+              if (root)
+                std::cout << "max difference " << diff << " (tolerance " << tol << ")"
+                          << std::endl;
+              return diff <= tol ? 0 : 1;
+            }
+          else if (arg == "--help" || arg == "-h")
+            {
+              if (root)
+                std::cout << "usage: perideal [--resume] [--stop-after-steps N] FILE.prm\n"
+                             "       perideal --print-parameters\n"
+                             "       perideal --compare NODES_A.csv NODES_B.csv TOL\n";
+              return 0;
+            }
+          else if (!arg.empty() && arg[0] == '-')
+            throw ParameterError("command line", arg,
+                                 "--print-parameters, --resume, --stop-after-steps N, "
+                                 "--compare A B TOL, or a parameter file");
+          else
+            file = arg;
+        }
+      if (file.empty())
+        throw ParameterError("command line", "(no parameter file)",
+                             "a parameter file: perideal FILE.prm (see --print-parameters)");
+      if (!std::ifstream(file))
+        throw ParameterError("command line", file, "a readable parameter file");
+      try
+        {
+          prm.parse_input(file);
+        }
+      catch (std::exception &e)
+        {
+          throw std::runtime_error("Could not read parameter file '" + file + "':\n" + e.what());
+        }
+
+      switch (prm.get_integer("Dimension"))
+        {
+          case 1:
+            run<1>(prm, resume, stop_after);
+            break;
+          case 2:
+            run<2>(prm, resume, stop_after);
+            break;
+          default:
+            run<3>(prm, resume, stop_after);
+        }
+    }
+  catch (std::exception &e)
+    {
+      std::cerr << "\nperideal: error: " << e.what() << std::endl;
+      return 1;
+    }
+  catch (...)
+    {
+      std::cerr << "\nperideal: unknown error" << std::endl;
+      return 1;
+    }
+  return 0;
+}

@@ -1,0 +1,280 @@
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/models/diffusion.h>
+
+#include <cmath>
+
+namespace PeriDEAL
+{
+  void
+  DiffusionModelParameters::declare_parameters(ParameterHandler &prm)
+  {
+    prm.declare_entry("Type", "diffusion", Patterns::Selection("diffusion|corrosion"),
+                      "diffusion: linear PD diffusion (2.41)-(2.42). corrosion: the "
+                      "bi-material corrosion model (2.48)-(2.49) with phase change "
+                      "(2.79): liquid-liquid bonds use the liquid micro-diffusivity, "
+                      "solid-liquid bonds the interface one, solid-solid bonds the "
+                      "solid one (default 0: no flux).");
+    prm.declare_entry("Influence function", "constant", Patterns::Selection("constant|linear"),
+                      "omega_0 = 1 (2.12) or omega_1 = 1 - r/delta (2.13).");
+    prm.declare_entry("Kernel exponent", "2", Patterns::Double(),
+                      "q: the kernel is kappa omega Theta / |xi|^q (convention J_q of "
+                      "(2.42)) or / |xi|^(n_d + 2q) (convention of (2.49)).");
+    prm.declare_entry("Kernel convention", "J_q", Patterns::Selection("J_q|n_d+2q"),
+                      "Which exponent the kernel uses, see 'Kernel exponent'.");
+    prm.declare_entry("Diffusivity", "1", Patterns::Double(),
+                      "Local diffusion coefficient D (> 0); kappa is computed from it "
+                      "by quadrature of the kernel (Table 4.1) unless "
+                      "'Micro-diffusivity' is positive.");
+    prm.declare_entry("Micro-diffusivity", "0", Patterns::Double(),
+                      "kappa of linear diffusion, used as given if > 0.");
+    prm.enter_subsection("Corrosion");
+    prm.declare_entry("Liquid micro-diffusivity", "2", Patterns::Double(),
+                      "kappa_liq of liquid-liquid bonds (>= 0).");
+    prm.declare_entry("Interface micro-diffusivity", "0.1", Patterns::Double(),
+                      "kappa_int of solid-liquid bonds (>= 0).");
+    prm.declare_entry("Solid micro-diffusivity", "0", Patterns::Double(),
+                      "kappa of solid-solid bonds (>= 0); 0 in the sources.");
+    prm.declare_entry("Saturation concentration", "0.85", Patterns::Double(),
+                      "C_sat of (2.79): a solid node becomes liquid once its "
+                      "concentration falls below it, and never turns back.");
+    prm.leave_subsection();
+  }
+
+  void
+  DiffusionModelParameters::parse_parameters(ParameterHandler &prm, const unsigned int dim)
+  {
+    type  = prm.get("Type");
+    omega = parse_influence_function(prm.get("Influence function"), "Model/Influence function");
+    const double q = prm.get_double("Kernel exponent");
+    exponent       = prm.get("Kernel convention") == "J_q" ? q : dim + 2. * q;
+    // The second moment exists only for 2 - exponent + dim - 1 > -1.
+    check_parameter(exponent < dim + 2., "Model/Kernel exponent", q,
+                    "a value for which the kernel has a finite second moment "
+                    "(exponent of |xi| < n_d + 2, i.e. q < " +
+                      std::to_string(prm.get("Kernel convention") == "J_q" ? dim + 2 : 1) + ")");
+    diffusivity       = prm.get_double("Diffusivity");
+    micro_diffusivity = prm.get_double("Micro-diffusivity");
+    check_parameter(micro_diffusivity >= 0., "Model/Micro-diffusivity", micro_diffusivity,
+                    "a non-negative number (0: compute from Diffusivity)");
+    if (micro_diffusivity == 0.)
+      check_parameter(diffusivity > 0., "Model/Diffusivity", diffusivity, "a positive number");
+    prm.enter_subsection("Corrosion");
+    kappa_liquid    = prm.get_double("Liquid micro-diffusivity");
+    kappa_interface = prm.get_double("Interface micro-diffusivity");
+    kappa_solid     = prm.get_double("Solid micro-diffusivity");
+    saturation      = prm.get_double("Saturation concentration");
+    prm.leave_subsection();
+    check_parameter(kappa_liquid >= 0., "Model/Corrosion/Liquid micro-diffusivity",
+                    kappa_liquid, "a non-negative number");
+    check_parameter(kappa_interface >= 0., "Model/Corrosion/Interface micro-diffusivity",
+                    kappa_interface, "a non-negative number");
+    check_parameter(kappa_solid >= 0., "Model/Corrosion/Solid micro-diffusivity",
+                    kappa_solid, "a non-negative number");
+  }
+
+  template <int dim>
+  DiffusionOperator<dim>::DiffusionOperator(const Discretization<dim>      &discretization,
+                                            const DiffusionModelParameters &p)
+    : disc(discretization)
+    , corrosion(p.type == "corrosion")
+  {
+    scalar_kernel.dim      = dim;
+    scalar_kernel.omega    = p.omega;
+    scalar_kernel.exponent = p.exponent;
+    scalar_kernel.delta    = disc.parameters().delta;
+    scalar_kernel.constant = 1.;
+    if (corrosion)
+      kappa_table = {{p.kappa_liquid, p.kappa_interface, p.kappa_interface, p.kappa_solid}};
+    else
+      {
+        const double kappa = p.micro_diffusivity > 0. ?
+                               p.micro_diffusivity :
+                               scalar_kernel.micro_constant_for(p.diffusivity);
+        scalar_kernel.constant = kappa;
+        kappa_table            = {{kappa, kappa, kappa, kappa}};
+      }
+
+    const auto &nb = disc.neighborhood;
+    geometric_weight.resize(nb.bond_length.size());
+    ScalarKernel shape = scalar_kernel;
+    shape.constant     = 1.;
+    // omega is evaluated at min(r, delta): bonds of the partial-volume shell
+    // beyond delta keep the kernel's value at the horizon, weighted by beta.
+    for (std::size_t t = 0; t < geometric_weight.size(); ++t)
+      geometric_weight[t] =
+        shape(std::min(nb.bond_length[t], shape.delta)) * nb.bond_weight[t];
+
+    row_sum.resize(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double *w = geometric_weight.data() + nb.table_start[i];
+        double        s = 0.;
+        for (std::uint64_t k = 0; k < nb.row_start[i + 1] - nb.row_start[i]; ++k)
+          s += w[k];
+        row_sum[i] = s;
+      }
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::apply(const Vector &C, Vector &rate, const Vector *phase) const
+  {
+    const auto          &nb        = disc.neighborhood;
+    const double *const  c         = C.begin();
+    double *const        r         = rate.begin();
+    const std::int32_t  *col       = nb.col.data();
+    const std::uint64_t *row_start = nb.row_start.data();
+    const std::uint64_t *table     = nb.table_start.data();
+    const double        *gw        = geometric_weight.data();
+    const unsigned int   n         = disc.n_owned();
+
+    if (!corrosion)
+      {
+        const double kappa = kappa_table[0];
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            const std::int32_t *ci = col + row_start[i];
+            const double       *wi = gw + table[i];
+            const unsigned int  m  = row_start[i + 1] - row_start[i];
+            double              s  = 0.;
+#pragma omp simd reduction(+ : s)
+            for (unsigned int k = 0; k < m; ++k)
+              s += wi[k] * c[ci[k]];
+            r[i] = kappa * (s - row_sum[i] * c[i]);
+          }
+        return;
+      }
+
+    AssertThrow(phase != nullptr, ExcMessage("The corrosion model needs the phase field."));
+    const double *const ph = phase->begin();
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        const std::int32_t *ci    = col + row_start[i];
+        const double       *wi    = gw + table[i];
+        const unsigned int  m     = row_start[i + 1] - row_start[i];
+        const double       *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
+        const double        c_i   = c[i];
+        double              s     = 0.;
+        for (unsigned int k = 0; k < m; ++k)
+          {
+            const std::int32_t j = ci[k];
+            s += wi[k] * kappa[ph[j] > 0.5] * (c[j] - c_i);
+          }
+        r[i] = s;
+      }
+  }
+
+  template <int dim>
+  double
+  DiffusionOperator<dim>::critical_time_step() const
+  {
+    const double kappa_max = *std::max_element(kappa_table.begin(), kappa_table.end());
+    double       max_sum   = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (disc.region[i] == Discretization<dim>::interior)
+        max_sum = std::max(max_sum, kappa_max * row_sum[i]);
+    max_sum = Utilities::MPI::max(max_sum, disc.get_mpi_communicator());
+    return max_sum > 0. ? 1. / max_sum : std::numeric_limits<double>::infinity();
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::assemble_backward_euler(const double                   dt,
+                                                  TrilinosWrappers::SparseMatrix &matrix,
+                                                  const Vector                   *phase) const
+  {
+    AssertThrow(!corrosion || phase != nullptr,
+                ExcMessage("The corrosion model needs the phase field."));
+    const auto &nb   = disc.neighborhood;
+    const auto &part = *disc.partitioner();
+    const auto  comm = disc.get_mpi_communicator();
+
+    auto global = [&](const unsigned int local) { return part.local_to_global(local); };
+    auto solid  = [&](const unsigned int local) {
+      return phase != nullptr && corrosion && phase->local_element(local) > 0.5;
+    };
+
+    TrilinosWrappers::SparsityPattern sp(part.locally_owned_range(),
+                                         part.locally_owned_range(),
+                                         part.ghost_indices(),
+                                         comm);
+    std::vector<types::global_dof_index> cols;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        cols.clear();
+        cols.push_back(global(i));
+        if (disc.region[i] == Discretization<dim>::interior)
+          for (std::uint64_t k = nb.row_start[i]; k < nb.row_start[i + 1]; ++k)
+            if (disc.region[nb.col[k]] == Discretization<dim>::interior)
+              cols.push_back(global(nb.col[k]));
+        sp.add_entries(global(i), cols.begin(), cols.end());
+      }
+    sp.compress();
+    matrix.reinit(sp);
+
+    std::vector<double> values;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        cols.clear();
+        values.clear();
+        cols.push_back(global(i));
+        values.push_back(0.);
+        if (disc.region[i] != Discretization<dim>::interior)
+          {
+            values[0] = 1.;
+          }
+        else
+          {
+            const double *w   = geometric_weight.data() + nb.table_start[i];
+            double        sum = 0.;
+            for (std::uint64_t k = nb.row_start[i]; k < nb.row_start[i + 1]; ++k)
+              {
+                const unsigned int j = nb.col[k];
+                const double a = bond_kappa(solid(i), solid(j)) * w[k - nb.row_start[i]];
+                sum += a;
+                if (disc.region[j] == Discretization<dim>::interior)
+                  {
+                    cols.push_back(global(j));
+                    values.push_back(-a);
+                  }
+              }
+            values[0] = 1. / dt + sum;
+          }
+        matrix.set(global(i), cols.size(), cols.data(), values.data());
+      }
+    matrix.compress(VectorOperation::insert);
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::add_constrained_coupling(const Vector &C,
+                                                   Vector       &rhs,
+                                                   const Vector *phase) const
+  {
+    const auto &nb    = disc.neighborhood;
+    auto        solid = [&](const unsigned int local) {
+      return phase != nullptr && corrosion && phase->local_element(local) > 0.5;
+    };
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        if (disc.region[i] != Discretization<dim>::interior)
+          continue;
+        const double *w = geometric_weight.data() + nb.table_start[i];
+        double        s = 0.;
+        for (std::uint64_t k = nb.row_start[i]; k < nb.row_start[i + 1]; ++k)
+          {
+            const unsigned int j = nb.col[k];
+            if (disc.region[j] != Discretization<dim>::interior)
+              s += bond_kappa(solid(i), solid(j)) * w[k - nb.row_start[i]] *
+                   C.local_element(j);
+          }
+        rhs.local_element(i) += s;
+      }
+  }
+
+  template class DiffusionOperator<1>;
+  template class DiffusionOperator<2>;
+  template class DiffusionOperator<3>;
+} // namespace PeriDEAL
