@@ -24,6 +24,23 @@ using namespace PeriDEAL;
 
 namespace
 {
+  // deal.II exceptions carry a banner and a stack trace; users need the
+  // explanation only.
+  std::string
+  user_message(const std::string &what)
+  {
+    const auto info = what.find("Additional information:");
+    if (info == std::string::npos)
+      return what;
+    std::string text  = what.substr(info + 23);
+    const auto  stack = text.find("Stacktrace:");
+    if (stack != std::string::npos)
+      text = text.substr(0, stack);
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '-'))
+      text.pop_back();
+    return text;
+  }
+
   void
   declare_all(ParameterHandler &prm)
   {
@@ -172,7 +189,8 @@ main(int argc, char **argv)
         }
       catch (std::exception &e)
         {
-          throw std::runtime_error("Could not read parameter file '" + file + "':\n" + e.what());
+          throw std::runtime_error("Could not read parameter file '" + file + "':\n" +
+                                   user_message(e.what()));
         }
 
       switch (prm.get_integer("Dimension"))
@@ -189,7 +207,7 @@ main(int argc, char **argv)
     }
   catch (std::exception &e)
     {
-      std::cerr << "\nperideal: error: " << e.what() << std::endl;
+      std::cerr << "\nperideal: error: " << user_message(e.what()) << std::endl;
       return 1;
     }
   catch (...)

@@ -62,6 +62,11 @@ namespace PeriDEAL
                       "Newton stops when |F| <= tol |F_0| (0 < tol < 1).");
     prm.declare_entry("Max Newton iterations", "10", Patterns::Integer(1),
                       "Upper limit of Newton iterations per step.");
+    prm.declare_entry("Preconditioner", "auto", Patterns::Selection("auto|AMG|Jacobi"),
+                      "Preconditioner of the linear solves: ML algebraic multigrid, "
+                      "Jacobi, or auto: Jacobi when dt is at most 10x the explicit "
+                      "stability bound (the matrix I/dt - L is then strongly "
+                      "diagonally dominant), AMG otherwise.");
     prm.leave_subsection();
 
     prm.enter_subsection("Output");
@@ -115,6 +120,7 @@ namespace PeriDEAL
     linear_tolerance      = p.get_double("Linear solver tolerance");
     newton_tolerance      = p.get_double("Newton tolerance");
     max_newton_iterations = p.get_integer("Max Newton iterations");
+    preconditioner        = p.get("Preconditioner");
     p.leave_subsection();
     check_parameter(time_step >= 0., "Time stepping/Time step", time_step,
                     "a positive number (or 0 for automatic with forward Euler)");
@@ -242,8 +248,8 @@ namespace PeriDEAL
     dt          = prm.time_step;
     if (prm.scheme == "forward Euler")
       {
-        if (dt == 0.)
-          dt = 0.9 * dt_critical;
+        if (dt == 0.) // the largest step <= 0.9 x bound that ends on the end time
+          dt = prm.end_time / std::ceil(prm.end_time / (0.9 * dt_critical));
         std::ostringstream bound;
         bound.precision(6);
         bound << "a value <= the forward Euler stability bound " << dt_critical
@@ -315,12 +321,19 @@ namespace PeriDEAL
     if (!matrix_valid)
       {
         op->assemble_backward_euler(dt, matrix, &phase);
-        TrilinosWrappers::PreconditionAMG::AdditionalData data;
-        data.elliptic              = true;
-        data.higher_order_elements = false;
-        data.smoother_sweeps       = 2;
-        data.aggregation_threshold = 0.02;
-        amg.initialize(matrix, data);
+        use_amg = prm.preconditioner == "AMG" ||
+                  (prm.preconditioner == "auto" && dt > 10. * dt_critical);
+        if (use_amg)
+          {
+            TrilinosWrappers::PreconditionAMG::AdditionalData data;
+            data.elliptic              = true;
+            data.higher_order_elements = false;
+            data.smoother_sweeps       = 2;
+            data.aggregation_threshold = 0.02;
+            amg.initialize(matrix, data);
+          }
+        else
+          jacobi.initialize(matrix);
         matrix_valid = true;
       }
 
@@ -363,15 +376,18 @@ namespace PeriDEAL
           break;
         SolverControl control(10000, prm.linear_tolerance * f);
         delta_c = 0.;
+        const TrilinosWrappers::PreconditionBase &preconditioner =
+          use_amg ? static_cast<const TrilinosWrappers::PreconditionBase &>(amg) :
+                    static_cast<const TrilinosWrappers::PreconditionBase &>(jacobi);
         if (op->is_corrosion())
           {
             TrilinosWrappers::SolverGMRES solver(control);
-            solver.solve(matrix, delta_c, residual, amg);
+            solver.solve(matrix, delta_c, residual, preconditioner);
           }
         else
           {
             TrilinosWrappers::SolverCG solver(control);
-            solver.solve(matrix, delta_c, residual, amg);
+            solver.solve(matrix, delta_c, residual, preconditioner);
           }
         linear_iterations += control.last_step();
         x.add(-1., delta_c); // lambda = 1

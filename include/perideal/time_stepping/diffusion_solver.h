@@ -47,6 +47,8 @@ namespace PeriDEAL
     double       linear_tolerance    = 1e-12;
     double       newton_tolerance    = 1e-10;
     unsigned int max_newton_iterations = 10;
+    /** "AMG", "Jacobi" or "auto" (Jacobi when dt is within 10x of the explicit bound). */
+    std::string preconditioner = "auto";
 
     std::string  output_directory     = "output";
     unsigned int snapshot_interval    = 0; ///< steps between VTU snapshots (0: first+last)
@@ -221,7 +223,9 @@ namespace PeriDEAL
     unsigned int newton_iterations = 0, linear_iterations = 0;
 
     TrilinosWrappers::SparseMatrix     matrix;
-    TrilinosWrappers::PreconditionAMG  amg;
+    TrilinosWrappers::PreconditionAMG    amg;
+    TrilinosWrappers::PreconditionJacobi jacobi;
+    bool                                 use_amg = true;
     bool                               matrix_valid = false;
     std::vector<DiffusionDiagnostics>  recorded;
 
