@@ -245,6 +245,45 @@ namespace
     quadratic_operator_dim<3>({3, 6});
   }
 
+  // A deal.II mesh as the body: GridGenerator::hyper_cube and a gmsh file of
+  // the same square give the same nodes, and the same layer (found by
+  // discrete dilation), as the box with its exact signed distance; a level
+  // set circle gives the ball's nodes.
+  void
+  mesh_domain()
+  {
+    std::ofstream("square.msh") << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n"
+                                   "1 -0.5 -0.5 0\n2 0.5 -0.5 0\n3 0.5 0.5 0\n4 -0.5 0.5 0\n"
+                                   "$EndNodes\n$Elements\n1\n1 3 2 0 1 1 2 3 4\n$EndElements\n";
+    const std::string common = "subsection Discretization\n set Grid spacing = 0.05\n"
+                               " set Horizon factor = 3\n set Volume constraint layer = -1\nend\n";
+    auto count = [&](const std::string &geometry) {
+      auto              p = parameters_from<2>("subsection Geometry\n" + geometry + "end\n" + common);
+      Discretization<2> d(MPI_COMM_WORLD);
+      d.setup(*p.domain, p.lattice);
+      unsigned int layer = 0;
+      for (unsigned int i = 0; i < d.n_owned(); ++i)
+        layer += d.region[i] == Discretization<2>::constrained;
+      return std::make_pair((unsigned int)d.n_global(), Utilities::MPI::sum(layer, MPI_COMM_WORLD));
+    };
+    const auto box  = count(" set Domain = box\n set Lower corner = -0.5, -0.5\n set Upper corner = 0.5, 0.5\n");
+    const auto cube = count(" set Domain = mesh\n set Grid generator = hyper_cube\n set Grid arguments = -0.5 : 0.5 : false\n");
+    const auto gmsh = count(" set Domain = mesh\n set Mesh file = square.msh\n");
+    // 21 x 21 body nodes; layer = 4 edge strips of 21 x 3 plus, per corner,
+    // the offsets (a, b) in 1..3 with a^2 + b^2 <= 9: (1,1) (1,2) (2,1) (2,2).
+    check(box.first == 21 * 21 + box.second && box.second == 4 * 21 * 3 + 4 * 4,
+          "box: " + std::to_string(box.first) + " nodes, " + std::to_string(box.second) + " in the layer");
+    check(cube == box, "GridGenerator hyper_cube body = box: " + std::to_string(cube.first) + " / " +
+                         std::to_string(cube.second));
+    check(gmsh == box, "gmsh square body = box: " + std::to_string(gmsh.first) + " / " +
+                         std::to_string(gmsh.second));
+    const auto ball  = count(" set Domain = ball\n set Center = 0, 0\n set Radius = 0.4\n");
+    const auto level = count(" set Domain = level set\n set Lower corner = -0.4, -0.4\n"
+                             " set Upper corner = 0.4, 0.4\n set Level set = sqrt(x^2 + y^2) - 0.4\n");
+    check(ball == level, "level set circle = ball: " + std::to_string(ball.first) + " / " +
+                           std::to_string(level.first));
+  }
+
   // Bad input ends in a ParameterError naming the parameter.
   template <typename F>
   void
@@ -492,6 +531,8 @@ end
       s.setup();
       while (s.step() < s.n_steps())
         s.advance();
+      check(Utilities::MPI::min(s.discretization().n_owned(), MPI_COMM_WORLD) > 0,
+            "every rank owns nodes");
       std::vector<std::pair<types::particle_index, double>> mine;
       for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
         mine.emplace_back(s.discretization().id[i], s.solution().local_element(i));
@@ -550,6 +591,7 @@ main(int argc, char **argv)
               {"family_counts", family_counts},
               {"quadratic_operator", quadratic_operator},
               {"bad_input", bad_input},
+              {"mesh_domain", mesh_domain},
               {"stability_bound", stability_bound},
               {"mass_conservation", mass_conservation},
               {"rank_invariance", rank_invariance}});

@@ -1,6 +1,6 @@
 perideal_add_test_program(diffusion_tests ${CMAKE_CURRENT_LIST_DIR}/diffusion_tests.cc)
 
-foreach(_t kernel_constants volume_factor family_counts bad_input stability_bound)
+foreach(_t kernel_constants volume_factor family_counts bad_input stability_bound mesh_domain)
   perideal_add_test(NAME diffusion.${_t} COMMAND $<TARGET_FILE:diffusion_tests> ${_t}
     LABELS unit)
 endforeach()

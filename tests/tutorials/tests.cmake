@@ -9,3 +9,5 @@ perideal_add_test(NAME tutorial.step-2 COMMAND $<TARGET_FILE:step-2> ${_t}/step-
 perideal_add_test(NAME tutorial.step-2.np2 NPROCS 2
   COMMAND $<TARGET_FILE:step-2> ${CMAKE_CURRENT_LIST_DIR}/step-2-explicit.prm
   LABELS "tutorial;mpi" TIMEOUT 1800)
+perideal_add_test(NAME tutorial.step-1.long COMMAND $<TARGET_FILE:step-1> ${CMAKE_CURRENT_LIST_DIR}/step-1-long.prm
+  LABELS "tutorial;convergence;long" TIMEOUT 7200)

@@ -194,7 +194,7 @@ main(int argc, char **argv)
               gp << "set terminal pngcairo size 900,600 noenhanced\nset output '"
                  << study.output << "/error_history.png'\n"
                  << "set datafile separator ','\nset logscale y\nset xlabel 'time'\n"
-                 << "set ylabel 'relative l2 error (3.79)'\nset grid\nset key bottom right\n"
+                 << "set ylabel 'relative l2 error (3.79)'\nset format y '%.0e'\nset grid\nset key bottom right\n"
                  << "plot ";
               bool first = true;
               for (const auto &[scheme, rs] : results)
