@@ -12,6 +12,7 @@
 
 #include <perideal/base/exceptions.h>
 #include <perideal/io/checkpoint.h>
+#include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
 
 #include <cstdlib>
@@ -53,33 +54,23 @@ namespace
     DiffusionRunParameters<2>::declare_parameters(prm);
   }
 
-  // A PNG of the time series with gnuplot, if it is installed.
+  // A PNG of the time series.
   void
   plot_time_series(const std::string &dir, const bool corrosion, const bool has_error)
   {
-    if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
-      {
-        std::cout << "(gnuplot not found: no PNG plot written)" << std::endl;
-        return;
-      }
-    const std::string script = dir + "/plot.gp";
-    std::ofstream     gp(script);
-    gp << "set terminal pngcairo size 900,600 noenhanced\n"
-       << "set output '" << dir << "/time_series.png'\n"
-       << "set datafile separator ','\nset key autotitle columnhead\n"
-       << "set xlabel 'time'\nset grid\n";
+    const std::string csv = "'" + dir + "/time_series.csv'";
+    std::string       gp  = gnuplot_png_preamble(dir + "/time_series.png") +
+                     "set datafile separator ','\nset key autotitle columnhead\nset xlabel 'time'\n";
     if (corrosion)
-      gp << "set ylabel 'solid volume'\nset y2label 'Pi = sum C^2 V'\nset y2tics\n"
-         << "plot '" << dir << "/time_series.csv' using 1:4 with lines lw 2, '' using 1:3 axes x1y2 with lines lw 2\n";
+      gp += "set ylabel 'solid volume'\nset y2label 'Pi = sum C^2 V'\nset y2tics\nplot " + csv +
+            " using 1:4 with lines lw 2, '' using 1:3 axes x1y2 with lines lw 2\n";
     else if (has_error)
-      gp << "set ylabel 'relative l2 error (3.79)'\nset logscale y\n"
-         << "plot '" << dir << "/time_series.csv' using 1:5 with lines lw 2\n";
+      gp += "set ylabel 'relative l2 error (3.79)'\nset logscale y\nplot " + csv +
+            " using 1:5 with lines lw 2\n";
     else
-      gp << "set ylabel 'mass, Pi'\n"
-         << "plot '" << dir << "/time_series.csv' using 1:2 with lines lw 2, '' using 1:3 with lines lw 2\n";
-    gp.close();
-    if (std::system(("gnuplot '" + script + "' 2> /dev/null").c_str()) == 0)
-      std::cout << "Plot: " << dir << "/time_series.png" << std::endl;
+      gp += "set ylabel 'mass, Pi'\nplot " + csv +
+            " using 1:2 with lines lw 2, '' using 1:3 with lines lw 2\n";
+    run_gnuplot(dir + "/plot.gp", gp, dir + "/time_series.png");
   }
 
   template <int dim>

@@ -21,6 +21,22 @@ namespace PeriDEAL
         line += (c > 0 ? "," : "") + columns[c];
       return line;
     }
+
+    /** One CSV line with 16 significant digits, newline included. */
+    std::string
+    format_row(const std::vector<double> &row)
+    {
+      std::string line;
+      char        buffer[40];
+      for (std::size_t c = 0; c < row.size(); ++c)
+        {
+          const int n = std::snprintf(buffer, sizeof(buffer), "%.16g", row[c]);
+          if (c > 0)
+            line += ',';
+          line.append(buffer, n);
+        }
+      return line + '\n';
+    }
   } // namespace
 
 
@@ -54,7 +70,23 @@ namespace PeriDEAL
                                   std::to_string(values.size()) + " values for " +
                                   std::to_string(column_names.size()) + " columns");
     data.push_back(values);
-    write();
+    if (rows_on_disk == 0 || rows_on_disk + 1 != data.size())
+      {
+        write();
+        return;
+      }
+    // Appending one complete line keeps each row O(1): rewriting the file per
+    // row would make long runs quadratic. A crash can at most cut the last
+    // line, which load_existing() then rejects; truncation and reloading
+    // rewrite the file atomically.
+    internal::run_on_root(mpi_communicator, [&]() {
+      std::ofstream out(filename, std::ios::app | std::ios::binary);
+      out << format_row(values);
+      out.flush();
+      if (!out)
+        throw std::runtime_error("Cannot append to time series '" + filename + "'");
+    });
+    rows_on_disk = data.size();
   }
 
 
@@ -79,20 +111,11 @@ namespace PeriDEAL
   {
     internal::run_on_root(mpi_communicator, [&]() {
       std::string text = join(column_names) + '\n';
-      char        buffer[40];
       for (const auto &row : data)
-        {
-          for (std::size_t c = 0; c < row.size(); ++c)
-            {
-              const int n = std::snprintf(buffer, sizeof(buffer), "%.16g", row[c]);
-              if (c > 0)
-                text += ',';
-              text.append(buffer, n);
-            }
-          text += '\n';
-        }
+        text += format_row(row);
       write_file_atomically(filename, text);
     });
+    rows_on_disk = data.size();
   }
 
 
@@ -152,6 +175,7 @@ namespace PeriDEAL
     data.clear();
     for (std::size_t first = 0; first < flat.size(); first += column_names.size())
       data.emplace_back(flat.begin() + first, flat.begin() + first + column_names.size());
+    rows_on_disk = exists ? data.size() : 0;
     return exists;
   }
 } // namespace PeriDEAL

@@ -22,6 +22,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <perideal/base/exceptions.h>
+#include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
 
 #include <filesystem>
@@ -188,30 +189,22 @@ main(int argc, char **argv)
                 csv << (scheme == "forward Euler" ? "explicit" : "implicit") << ","
                     << study.divisions[k] << "," << h.first << "," << h.second << "\n";
           csv.close();
-          if (std::system("command -v gnuplot > /dev/null 2>&1") == 0)
-            {
-              std::ofstream gp(study.output + "/plot.gp");
-              gp << "set terminal pngcairo size 900,600 noenhanced\nset output '"
-                 << study.output << "/error_history.png'\n"
-                 << "set datafile separator ','\nset logscale y\nset xlabel 'time'\n"
-                 << "set ylabel 'relative l2 error (3.79)'\nset format y '%.0e'\nset grid\nset key bottom right\n"
-                 << "plot ";
-              bool first = true;
-              for (const auto &[scheme, rs] : results)
-                for (unsigned int k = 0; k < rs.size(); ++k)
-                  {
-                    const std::string tag = scheme == "forward Euler" ? "explicit" : "implicit";
-                    gp << (first ? "" : ", ") << "'" << study.output
-                       << "/error_history.csv' using ($2==" << study.divisions[k]
-                       << " && strcol(1) eq '" << tag << "' ? $3 : 1/0):4 with lines lw 2 title '"
-                       << tag << " dx = 1/" << study.divisions[k] << "'";
-                    first = false;
-                  }
-              gp << "\n";
-              gp.close();
-              if (std::system(("gnuplot " + study.output + "/plot.gp 2> /dev/null").c_str()) == 0)
-                std::cout << "Plot: " << study.output << "/error_history.png\n";
-            }
+          std::string gp = gnuplot_png_preamble(study.output + "/error_history.png") +
+                           "set datafile separator ','\nset logscale y\nset xlabel 'time'\n"
+                           "set ylabel 'relative l2 error (3.79)'\nset format y '%.0e'\n"
+                           "set key bottom right\nplot ";
+          bool first = true;
+          for (const auto &[scheme, rs] : results)
+            for (unsigned int k = 0; k < rs.size(); ++k)
+              {
+                const std::string tag = scheme == "forward Euler" ? "explicit" : "implicit";
+                gp += std::string(first ? "" : ", ") + "'" + study.output +
+                      "/error_history.csv' using ($2==" + std::to_string(study.divisions[k]) +
+                      " && strcol(1) eq '" + tag + "' ? $3 : 1/0):4 with lines lw 2 title '" + tag +
+                      " dx = 1/" + std::to_string(study.divisions[k]) + "'";
+                first = false;
+              }
+          run_gnuplot(study.output + "/plot.gp", gp + "\n", study.output + "/error_history.png");
 
           // @sect3{Checks}
           // Observed order between the two finest grids: the error is the

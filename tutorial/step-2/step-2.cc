@@ -25,6 +25,7 @@
 #include <deal.II/base/table_handler.h>
 
 #include <perideal/base/exceptions.h>
+#include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
 
 #include <filesystem>
@@ -169,26 +170,19 @@ main(int argc, char **argv)
               csv << r.grid << "," << (r.scheme == "forward Euler" ? "explicit" : "implicit")
                   << "," << h[0] << "," << h[1] << "," << h[2] << "\n";
           csv.close();
-          if (std::system("command -v gnuplot > /dev/null 2>&1") == 0)
+          std::string gp = gnuplot_png_preamble(out + "/solid_volume.png") +
+                           "set datafile separator ','\nset xlabel 'time'\n"
+                           "set ylabel 'solid volume (length)'\nplot ";
+          bool first = true;
+          for (const auto &r : runs)
             {
-              std::ofstream gp(out + "/plot.gp");
-              gp << "set terminal pngcairo size 900,600 noenhanced\nset output '" << out
-                 << "/solid_volume.png'\nset datafile separator ','\nset xlabel 'time'\n"
-                 << "set ylabel 'solid volume (length)'\nset grid\nplot ";
-              bool first = true;
-              for (const auto &r : runs)
-                {
-                  const std::string tag = r.scheme == "forward Euler" ? "explicit" : "implicit";
-                  gp << (first ? "" : ", ") << "'" << out << "/solid_volume.csv' using (strcol(1) eq '"
-                     << r.grid << "' && strcol(2) eq '" << tag << "' ? $3 : 1/0):4 with lines lw 2 title '"
-                     << r.grid << " " << tag << "'";
-                  first = false;
-                }
-              gp << "\n";
-              gp.close();
-              if (std::system(("gnuplot " + out + "/plot.gp 2> /dev/null").c_str()) == 0)
-                std::cout << "Plot: " << out << "/solid_volume.png\n";
+              const std::string tag = r.scheme == "forward Euler" ? "explicit" : "implicit";
+              gp += std::string(first ? "" : ", ") + "'" + out + "/solid_volume.csv' using (strcol(1) eq '" +
+                    r.grid + "' && strcol(2) eq '" + tag + "' ? $3 : 1/0):4 with lines lw 2 title '" +
+                    r.grid + " " + tag + "'";
+              first = false;
             }
+          run_gnuplot(out + "/plot.gp", gp + "\n", out + "/solid_volume.png");
 
           // @sect3{Checks}
           auto report = [&](const bool c, const std::string &what) {

@@ -44,7 +44,7 @@ namespace PeriDEAL
                const bool                      load_existing_file = false);
 
     /**
-     * Append a row and rewrite the file. Throws std::invalid_argument if
+     * Append a row to the file (a full atomic rewrite if the file is not in step with the rows in memory). Throws std::invalid_argument if
      * @p values does not have one entry per column. Collective.
      */
     void
@@ -99,6 +99,8 @@ namespace PeriDEAL
     std::string                      filename;
     std::vector<std::string>         column_names;
     std::vector<std::vector<double>> data;
+    /** Rows of data that the file holds (appending continues from there). */
+    mutable std::size_t rows_on_disk = 0;
   };
 } // namespace PeriDEAL
 
