@@ -7,7 +7,8 @@
 //     C.update_ghost_values(); op.apply(C, rate); C.add(dt, rate);
 // with dt = 0.5 * op.critical_time_step(), and prints `key: value` lines:
 // bond updates per second per core (global bonds x steps / (wall seconds x
-// ranks)), bytes per bond, setup times. It also times prototype variants of
+// ranks); also per thread CPU second), bytes per bond, setup times. Timed
+// loops keep their fastest chunk of calls: the machine may be shared. It also times prototype variants of
 // the apply loop (same data, checked against op.apply) so that faster
 // loops can be measured before they go into source/models/diffusion.cc.
 //
@@ -31,18 +32,23 @@
 #include <perideal/discretization/domain.h>
 #include <perideal/models/diffusion.h>
 
-#include <immintrin.h>
+#ifdef __AVX512F__
+#  include <immintrin.h>
+#endif
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -357,6 +363,9 @@ namespace
   }
 
 #ifdef __AVX512F__
+// GCC 12's _mm512_reduce_add_pd uses _mm256_undefined_pd(): not a bug.
+#  pragma GCC diagnostic push
+#  pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
   // (d) Explicit AVX-512 gathers: 8 bonds per gather, masked tail (no
   // scalar remainder loop), two accumulators.
   void
@@ -391,6 +400,7 @@ namespace
         d.r[i]         = d.kappa * (s - d.row_sum[i] * d.c[i]);
       }
   }
+#  pragma GCC diagnostic pop
 #endif
 
   // (e) Roofline probe, not a valid operator: the same row loop streaming
@@ -421,30 +431,51 @@ namespace
     checksum += t;
   }
 
+  /** CPU seconds of the calling thread. */
+  double
+  thread_cpu_seconds()
+  {
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+  }
+
+  struct Timing
+  {
+    double wall = 0.; ///< max over ranks of the wall seconds
+    double cpu  = 0.; ///< sum over ranks of the thread CPU seconds
+  };
+
   /**
-   * Wall seconds of @p steps calls of @p f, timed in up to ten chunks: the
+   * Seconds of @p steps calls of @p f, timed in up to ten chunks: the
    * result is steps x the fastest chunk's time per call (the machine is
-   * shared, the best chunk is the least disturbed one). Max over ranks.
+   * shared, the best chunk is the least disturbed one). Wall time with
+   * MPI_Wtime (max over ranks) and, as a cross-check that does not count
+   * time the scheduler gave to other processes, thread CPU time (sum over
+   * ranks).
    */
   template <typename F>
-  double
+  Timing
   time_loop(const MPI_Comm comm, const unsigned int steps, F &&f)
   {
     const unsigned int chunks = std::min(10u, steps);
-    double             best   = std::numeric_limits<double>::max();
-    unsigned int       done   = 0;
+    Timing             best{std::numeric_limits<double>::max(),
+                std::numeric_limits<double>::max()};
+    unsigned int       done = 0;
     for (unsigned int c = 0; c < chunks; ++c)
       {
         const unsigned int n = (steps - done) / (chunks - c);
         MPI_Barrier(comm);
-        const double t0 = MPI_Wtime();
+        const double t0 = MPI_Wtime(), c0 = thread_cpu_seconds();
         for (unsigned int s = 0; s < n; ++s)
           f();
-        const double t = Utilities::MPI::max(MPI_Wtime() - t0, comm);
-        best           = std::min(best, t / n);
+        const double cpu = Utilities::MPI::sum(thread_cpu_seconds() - c0, comm);
+        const double t   = Utilities::MPI::max(MPI_Wtime() - t0, comm);
+        best.wall        = std::min(best.wall, t / n);
+        best.cpu         = std::min(best.cpu, cpu / n);
         done += n;
       }
-    return best * steps;
+    return {best.wall * steps, best.cpu * steps};
   }
 
   struct CaseResult
@@ -554,13 +585,27 @@ namespace
     print("bytes_per_bond", (nb_bytes + op_bytes + vec_bytes) / bonds);
     print("rss_bytes_per_bond", rss_delta / bonds);
     print("peak_rss_bytes_per_bond", rss_peak / bonds);
-    // Estimate: boundary rows referring to the shared stencil through a
-    // 2-byte slot per bond instead of copies of |xi|, beta V (16 B) and the
-    // operator's geometric weight (8 B).
-    const double copied = Utilities::MPI::sum(
-      double(nb.bond_length.size()) - double(nb.stencil_size), comm);
-    print("bytes_per_bond_with_slot_tables",
-          (nb_bytes + op_bytes + vec_bytes - copied * (16. + 8. - 2.)) / bonds);
+    // Capacity the CSR holds beyond its sizes (vectors grown by push_back).
+    const double unused = Utilities::MPI::sum(
+      double((nb.row_start.capacity() - nb.row_start.size()) * sizeof(std::uint64_t) +
+             (nb.col.capacity() - nb.col.size()) * sizeof(std::int32_t) +
+             (nb.table_start.capacity() - nb.table_start.size()) * sizeof(std::uint64_t) +
+             (nb.bond_length.capacity() - nb.bond_length.size() + nb.bond_weight.capacity() -
+              nb.bond_weight.size()) *
+               sizeof(double)),
+      comm);
+    print("neighborhood_unused_capacity_bytes_per_bond", unused / bonds);
+    // Estimate of a layout where boundary rows refer to the shared stencil
+    // through a 2-byte slot per bond instead of copies of |xi| and beta V
+    // (16 B) and the operator's geometric weight (8 B), without unused
+    // capacity: row_start + table_start + col + slots + stencil tables +
+    // row sums + vectors.
+    const double copied = double(nb.bond_length.size()) - double(nb.stencil_size);
+    const double slot_layout = Utilities::MPI::sum(
+      double(nb.row_start.size() * 8 + nb.table_start.size() * 8 + nb.col.size() * 4) +
+        copied * 2. + nb.stencil_size * 24. + disc.n_owned() * 8.,
+      comm);
+    print("bytes_per_bond_with_slot_tables", (slot_layout + vec_bytes) / bonds);
     if (c.name == "3d_m3" && rank == 0)
       std::printf("diffusion_3d_bytes_per_bond: %.6g\n",
                   (nb_bytes + op_bytes + vec_bytes) / bonds);
@@ -577,11 +622,11 @@ namespace
     print("dt", dt);
 
     // Warm-up step, which also calibrates the number of steps.
-    double t_one = time_loop(comm, 1, [&] {
-      C.update_ghost_values();
-      op.apply(C, rate);
-      C.add(dt, rate);
-    });
+    const double t_one = time_loop(comm, 1, [&] {
+                           C.update_ghost_values();
+                           op.apply(C, rate);
+                           C.add(dt, rate);
+                         }).wall;
     unsigned int steps = opt.steps;
     if (steps == 0)
       steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
@@ -593,24 +638,27 @@ namespace
       return bond_updates / (seconds * n_ranks);
     };
 
-    const double t_step = time_loop(comm, steps, [&] {
+    const Timing t_step = time_loop(comm, steps, [&] {
       C.update_ghost_values();
       op.apply(C, rate);
       C.add(dt, rate);
     });
-    print("step_seconds", t_step / steps);
-    print("bond_updates_per_s_per_core", rate_of(t_step));
+    print("step_seconds", t_step.wall / steps);
+    print("bond_updates_per_s_per_core", rate_of(t_step.wall));
+    print("bond_updates_per_cpu_second", bond_updates / t_step.cpu);
     flush();
 
     C.update_ghost_values();
-    const double t_apply = time_loop(comm, steps, [&] { op.apply(C, rate); });
+    const Timing t_apply_timing = time_loop(comm, steps, [&] { op.apply(C, rate); });
+    const double t_apply        = t_apply_timing.wall;
     print("apply_seconds", t_apply / steps);
     print("apply_bond_updates_per_s_per_core", rate_of(t_apply));
+    print("apply_bond_updates_per_cpu_second", bond_updates / t_apply_timing.cpu);
     print("ghost_update_seconds",
-          time_loop(comm, steps, [&] { C.update_ghost_values(); }) / steps);
+          time_loop(comm, steps, [&] { C.update_ghost_values(); }).wall / steps);
     // (a nonzero factor: add() returns at once for 0; this also refreshes
     // the ghosts of C, which add() does for a ghosted vector)
-    print("vector_add_seconds", time_loop(comm, steps, [&] { C.add(dt, rate); }) / steps);
+    print("vector_add_seconds", time_loop(comm, steps, [&] { C.add(dt, rate); }).wall / steps);
     flush();
 
     if (!opt.prototypes)

@@ -577,6 +577,8 @@ namespace PeriDEAL
       }
     AssertThrow(row == n_owned_nodes, ExcInternalError());
     nb.col.shrink_to_fit();
+    nb.bond_length.shrink_to_fit();
+    nb.bond_weight.shrink_to_fit();
   }
 
   template class Discretization<1>;

@@ -1,0 +1,221 @@
+#ifndef perideal_models_bond_based_h
+#define perideal_models_bond_based_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+
+#include <perideal/base/kernel.h>
+#include <perideal/discretization/discretization.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  /**
+   * Parameters of bond-based PD elasticity with bond breaking (dissertation
+   * Sect. 2.2): the prototype microelastic brittle (PMB) / generalized
+   * bond-based (GPBM) material (2.27)-(2.34) or its linearization (2.32).
+   * Poisson's ratio is fixed by the model: 1/4 in 1D/3D and plane strain,
+   * 1/3 in plane stress.
+   */
+  struct BondBasedModelParameters
+  {
+    /** Influence function omega. */
+    InfluenceFunction omega = InfluenceFunction::constant;
+    /** Young's modulus E (> 0); c is computed from it unless micromodulus > 0. */
+    double youngs_modulus = 1.;
+    /** c; used as given if > 0. */
+    double micromodulus = 0.;
+    /** 2D only: plane stress (nu = 1/3) or plane strain (nu = 1/4). */
+    bool plane_stress = true;
+    /** Linearized bond-based model (2.32) instead of the nonlinear PMB force. */
+    bool linearized = false;
+    /**
+     * Fracture energy G0 (>= 0); s0 is computed from it unless
+     * critical_stretch > 0. Both 0: bonds never break.
+     */
+    double fracture_energy = 0.;
+    /** s0; used as given if > 0. */
+    double critical_stretch = 0.;
+
+    /** Declare the "Model" entries of the bond-based model. */
+    static void
+    declare_parameters(ParameterHandler &prm);
+    /** Read and validate them (the caller has entered "Model"). */
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /**
+   * Strain energy density of the classical (CCM) material under the
+   * isotropic expansion u = eps x, divided by eps^2: E/2 (1D),
+   * 2 K_2D with K_2D = E / (2 (1 - nu)) (plane stress, nu = 1/3) or
+   * lambda + mu = E / (2 (1 + nu)(1 - 2 nu)) (plane strain, nu = 1/4), and
+   * 9 K / 2 with K = E / (3 (1 - 2 nu)) (3D, nu = 1/4).
+   */
+  double
+  isotropic_expansion_energy(const unsigned int dim,
+                             const double       youngs_modulus,
+                             const bool         plane_stress = true);
+
+  /**
+   * The micromodulus c that makes the PD energy density of an isotropic
+   * expansion in the bulk,
+   * W_pd = (c eps^2 / 4) int_H omega(|xi|) |xi| dV
+   *      = (c eps^2 / 4) |S^{d-1}| int_0^delta omega(r) r^d dr,
+   * equal to the CCM value isotropic_expansion_energy(); computed by
+   * radial quadrature. Reproduces (2.31), 2E/delta^2 (1D, (3.71)) and
+   * 18K/(pi delta^4) (3D).
+   */
+  double
+  bond_based_micromodulus(const unsigned int      dim,
+                          const InfluenceFunction omega,
+                          const double            delta,
+                          const double            youngs_modulus,
+                          const bool              plane_stress = true);
+
+  /**
+   * The critical stretch s0 for fracture energy G0 and micromodulus c: the
+   * energy c omega s0^2 |xi| / 2 of every bond crossing a unit crack area,
+   * summed as in Silling-Askari (2005) and (2.35), equals G0:
+   *   1D: G0 = (c s0^2 / 2) int_0^delta omega r^2 dr,
+   *   2D: G0 = c s0^2 int_0^delta omega r^3 dr,
+   *   3D: G0 = (pi c s0^2 / 2) int_0^delta omega r^4 dr
+   * (the inner integral over the crack-normal distance z is done in closed
+   * form). With the plane-stress c this is (2.35); with the plane-strain
+   * c = 48E/(5 pi delta^3) (omega_0) it gives s0 = sqrt(5 pi G0/(12 E delta)),
+   * and with 192E/(5 pi delta^3) (omega_1) s0 = sqrt(25 pi G0/(48 E delta)).
+   */
+  double
+  bond_based_critical_stretch(const unsigned int      dim,
+                              const InfluenceFunction omega,
+                              const double            delta,
+                              const double            micromodulus,
+                              const double            fracture_energy);
+
+  /**
+   * The bond-based PD force density of the standard scheme (3.1),
+   * @f[ F_i = \sum_{j \in F_i} \mu_{ij} \, c \, \omega(|\xi|) \, s_{ij}
+   *   \frac{\xi + \eta}{|\xi + \eta|} \beta V_j, @f]
+   * or with the linearized bond force (2.32) c omega (xi (x) xi / |xi|^3) eta.
+   * Each bond stored in a row of the Neighborhood carries an irreversible
+   * broken flag mu (2.34); a bond breaks when its stretch exceeds s0. Both
+   * end points decide independently from the bitwise same stretch, so the
+   * two copies of a bond agree across ranks. Bond coefficients share the
+   * Neighborhood's table layout (interior rows use one stencil table).
+   */
+  template <int dim>
+  class BondBasedOperator
+  {
+  public:
+    /** A displacement or force field: one node Vector per component. */
+    using VectorField = std::array<Vector, dim>;
+
+    BondBasedOperator(const Discretization<dim>      &discretization,
+                      const BondBasedModelParameters &parameters);
+
+    /** The micromodulus c in use. */
+    double
+    micromodulus() const
+    {
+      return c;
+    }
+    /** The critical stretch s0 (infinity if bonds never break). */
+    double
+    critical_stretch() const
+    {
+      return s0;
+    }
+    /** The discretization. */
+    const Discretization<dim> &
+    discretization() const
+    {
+      return disc;
+    }
+
+    /** Zero-initialized dim node Vectors. */
+    void
+    initialize(VectorField &field) const;
+
+    /**
+     * force_i = F_i (force per unit volume) for the owned nodes; breaks the
+     * bonds whose stretch now exceeds s0 (their force is already zero).
+     * @p u must have up-to-date ghost values.
+     */
+    void
+    compute_forces(const VectorField &u, VectorField &force);
+
+    /**
+     * W_i = 1/2 sum_j mu 1/2 c omega s^2 |xi| beta V_j (2.26)-(2.27): each
+     * bond's energy split between its end points. Owned entries of @p W.
+     */
+    void
+    strain_energy_density(const VectorField &u, Vector &W) const;
+
+    /** sum_i W_i V_i over all ranks. */
+    double
+    total_strain_energy(const VectorField &u) const;
+
+    /** Damage (2.36) 1 - sum mu beta V / sum beta V of the owned nodes. */
+    void
+    damage(Vector &phi) const;
+
+    /**
+     * Break every bond of the owned rows for which @p cuts(x_i, x_j) is
+     * true. The predicate must be symmetric; it is called with the end
+     * points ordered by node id so that the two copies of a bond agree.
+     */
+    void
+    break_bonds(const std::function<bool(const Point<dim> &, const Point<dim> &)> &cuts);
+
+    /**
+     * 2D: pre-crack along the segment [a, b]: break the bonds whose segment
+     * x_i x_j properly intersects it. Throws for dim != 2.
+     */
+    void
+    add_precrack(const Point<dim> &a, const Point<dim> &b);
+
+    /** Broken flag (1 broken) per CSR bond of the owned rows. */
+    const std::vector<std::uint8_t> &
+    broken() const
+    {
+      return broken_flag;
+    }
+
+    /** Global number of broken bond copies (each bond counts once per owned row). */
+    std::uint64_t
+    n_broken_bonds() const;
+
+    /**
+     * sum_j ||C(xi)|| beta V_j = sum_j c omega / |xi| beta V_j of the owned
+     * row @p i: the stiffness of the linearized model used by (3.8).
+     */
+    double
+    stiffness_row_sum(const unsigned int i) const
+    {
+      return row_stiffness[i];
+    }
+
+    /**
+     * The critical time step (3.8) min_i sqrt(2 rho / sum_j ||C(xi)|| beta V_j)
+     * over all ranks, for density @p rho.
+     */
+    double
+    critical_time_step(const double rho) const;
+
+  private:
+    const Discretization<dim> &disc;
+    double                     c, s0;
+    bool                       linearized;
+    /** c omega(min(|xi|, delta)) beta V_j per table entry. */
+    std::vector<double> bond_coefficient;
+    std::vector<double> row_stiffness;
+    std::vector<std::uint8_t> broken_flag;
+  };
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,345 @@
+#include <deal.II/base/mpi.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/models/bond_based.h>
+
+#include <cmath>
+#include <limits>
+
+namespace PeriDEAL
+{
+  void
+  BondBasedModelParameters::declare_parameters(ParameterHandler &prm)
+  {
+    prm.declare_entry("Influence function", "constant", Patterns::Selection("constant|linear"),
+                      "omega_0 = 1 (2.12) or omega_1 = 1 - r/delta (2.13).");
+    prm.declare_entry("Young's modulus", "1", Patterns::Double(),
+                      "E (> 0); the micromodulus c is computed from it by matching the "
+                      "energy of an isotropic expansion (2.31) unless 'Micromodulus' > 0.");
+    prm.declare_entry("Micromodulus", "0", Patterns::Double(), "c, used as given if > 0.");
+    prm.declare_entry("Plane", "stress", Patterns::Selection("stress|strain"),
+                      "2D only: plane stress (nu = 1/3) or plane strain (nu = 1/4).");
+    prm.declare_entry("Linearized", "false", Patterns::Bool(),
+                      "Use the linearized bond force (2.32) instead of (2.29)-(2.30).");
+    prm.declare_entry("Fracture energy", "0", Patterns::Double(),
+                      "G0 (>= 0); the critical stretch is computed from it (2.35) unless "
+                      "'Critical stretch' > 0. Both 0: no bond breaking.");
+    prm.declare_entry("Critical stretch", "0", Patterns::Double(), "s0, used as given if > 0.");
+  }
+
+  void
+  BondBasedModelParameters::parse_parameters(ParameterHandler &prm)
+  {
+    omega = parse_influence_function(prm.get("Influence function"), "Model/Influence function");
+    youngs_modulus   = prm.get_double("Young's modulus");
+    micromodulus     = prm.get_double("Micromodulus");
+    plane_stress     = prm.get("Plane") == "stress";
+    linearized       = prm.get_bool("Linearized");
+    fracture_energy  = prm.get_double("Fracture energy");
+    critical_stretch = prm.get_double("Critical stretch");
+    check_parameter(micromodulus >= 0., "Model/Micromodulus", micromodulus,
+                    "a non-negative number (0: compute from Young's modulus)");
+    if (micromodulus == 0.)
+      check_parameter(youngs_modulus > 0., "Model/Young's modulus", youngs_modulus,
+                      "a positive number");
+    check_parameter(fracture_energy >= 0., "Model/Fracture energy", fracture_energy,
+                    "a non-negative number (0: no breaking unless 'Critical stretch' > 0)");
+    check_parameter(critical_stretch >= 0., "Model/Critical stretch", critical_stretch,
+                    "a non-negative number (0: compute from 'Fracture energy')");
+  }
+
+  double
+  isotropic_expansion_energy(const unsigned int dim, const double E, const bool plane_stress)
+  {
+    switch (dim)
+      {
+        case 1:
+          return 0.5 * E;
+        case 2:
+          {
+            // W = mu eps:eps + lambda/2 tr(eps)^2 = 2 (lambda + mu) eps^2 for
+            // plane strain; plane stress has the 2D bulk modulus E/(2(1-nu)).
+            const double nu = plane_stress ? 1. / 3. : 0.25;
+            return plane_stress ? 2. * E / (2. * (1. - nu)) :
+                                  2. * E / (2. * (1. + nu) * (1. - 2. * nu));
+          }
+        case 3:
+          return 4.5 * E / (3. * (1. - 2. * 0.25));
+        default:
+          throw ParameterError("dimension", std::to_string(dim), "1, 2 or 3");
+      }
+  }
+
+  namespace
+  {
+    double
+    unit_sphere_area(const unsigned int dim)
+    {
+      return dim == 1 ? 2. : dim == 2 ? 2. * M_PI : 4. * M_PI;
+    }
+  } // namespace
+
+  double
+  bond_based_micromodulus(const unsigned int      dim,
+                          const InfluenceFunction omega,
+                          const double            delta,
+                          const double            E,
+                          const bool              plane_stress)
+  {
+    const double integral = unit_sphere_area(dim) * radial_moment(omega, delta, dim);
+    return 4. * isotropic_expansion_energy(dim, E, plane_stress) / integral;
+  }
+
+  double
+  bond_based_critical_stretch(const unsigned int      dim,
+                              const InfluenceFunction omega,
+                              const double            delta,
+                              const double            c,
+                              const double            G0)
+  {
+    // G0 = sum of the energies c omega s0^2 r / 2 of all bonds crossing a unit
+    // crack area. Integrating first over the normal distance z < r of the
+    // lower end point leaves, per bond length r, the factor r (1D: one
+    // direction), 2 r^2 int_0^1 acos(t) dt = 2 r^2 (2D) and
+    // 2 pi r^2 * r/2 (3D, the spherical cap), giving the prefactors below
+    // times int_0^delta omega r^{d+1} dr.
+    const double prefactor = dim == 1 ? 0.5 : dim == 2 ? 1. : 0.5 * M_PI;
+    const double energy_per_s2 = prefactor * c * radial_moment(omega, delta, dim + 1.);
+    return std::sqrt(G0 / energy_per_s2);
+  }
+
+  template <int dim>
+  BondBasedOperator<dim>::BondBasedOperator(const Discretization<dim>      &discretization,
+                                            const BondBasedModelParameters &p)
+    : disc(discretization)
+    , linearized(p.linearized)
+  {
+    const double delta = disc.parameters().delta;
+    c = p.micromodulus > 0. ?
+          p.micromodulus :
+          bond_based_micromodulus(dim, p.omega, delta, p.youngs_modulus, p.plane_stress);
+    s0 = p.critical_stretch > 0. ? p.critical_stretch :
+         p.fracture_energy > 0.  ? bond_based_critical_stretch(dim, p.omega, delta, c,
+                                                               p.fracture_energy) :
+                                   std::numeric_limits<double>::infinity();
+
+    const auto &nb = disc.neighborhood;
+    // omega at min(r, delta): bonds of the partial-volume shell beyond delta
+    // keep the horizon value, weighted by beta (as in the diffusion model).
+    bond_coefficient.resize(nb.bond_length.size());
+    for (std::size_t t = 0; t < bond_coefficient.size(); ++t)
+      bond_coefficient[t] =
+        c * influence(p.omega, std::min(nb.bond_length[t], delta), delta) * nb.bond_weight[t];
+
+    row_stiffness.resize(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        double s = 0.;
+        for (std::uint64_t k = 0; k < nb.row_start[i + 1] - nb.row_start[i]; ++k)
+          s += bond_coefficient[nb.table_start[i] + k] / nb.bond_length[nb.table_start[i] + k];
+        row_stiffness[i] = s;
+      }
+    broken_flag.assign(nb.n_bonds(), 0);
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::initialize(VectorField &field) const
+  {
+    for (auto &v : field)
+      disc.initialize_vector(v);
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::compute_forces(const VectorField &u, VectorField &force)
+  {
+    const auto                   &nb  = disc.neighborhood;
+    const std::vector<Point<dim>> &x   = disc.position;
+    std::array<const double *, dim> ud;
+    for (unsigned int d = 0; d < dim; ++d)
+      ud[d] = u[d].begin();
+
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *coef  = bond_coefficient.data() + nb.table_start[i];
+        double              f[dim] = {};
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            if (broken_flag[b])
+              continue;
+            const std::int32_t j = nb.col[b];
+            // xi and eta from positions so that the copy of the bond in row
+            // j sees exactly -xi, -eta and hence the bitwise same stretch.
+            double xi[dim], y[dim], r2 = 0., l2 = 0., xe = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                xi[d]            = x[j][d] - x[i][d];
+                const double eta = ud[d][j] - ud[d][i];
+                y[d]             = xi[d] + eta;
+                r2 += xi[d] * xi[d];
+                l2 += y[d] * y[d];
+                xe += xi[d] * eta;
+              }
+            const double r = std::sqrt(r2);
+            double       s, scale;
+            const double *dir;
+            if (linearized)
+              {
+                s     = xe / r2;
+                scale = coef[b - begin] * s / r;
+                dir   = xi;
+              }
+            else
+              {
+                const double l = std::sqrt(l2);
+                s              = (l - r) / r;
+                scale          = coef[b - begin] * s / l;
+                dir            = y;
+              }
+            if (s > s0)
+              {
+                broken_flag[b] = 1;
+                continue;
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              f[d] += scale * dir[d];
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          force[d].local_element(i) = f[d];
+      }
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::strain_energy_density(const VectorField &u, Vector &W) const
+  {
+    const auto &nb = disc.neighborhood;
+    const auto &x  = disc.position;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *coef  = bond_coefficient.data() + nb.table_start[i];
+        double              w     = 0.;
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            if (broken_flag[b])
+              continue;
+            const std::int32_t j = nb.col[b];
+            double             r2 = 0., l2 = 0., xe = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double xi  = x[j][d] - x[i][d];
+                const double eta = u[d].local_element(j) - u[d].local_element(i);
+                r2 += xi * xi;
+                l2 += (xi + eta) * (xi + eta);
+                xe += xi * eta;
+              }
+            const double r = std::sqrt(r2);
+            const double s = linearized ? xe / r2 : (std::sqrt(l2) - r) / r;
+            w += coef[b - begin] * s * s * r;
+          }
+        W.local_element(i) = 0.25 * w;
+      }
+  }
+
+  template <int dim>
+  double
+  BondBasedOperator<dim>::total_strain_energy(const VectorField &u) const
+  {
+    Vector W;
+    disc.initialize_vector(W);
+    strain_energy_density(u, W);
+    double e = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      e += W.local_element(i) * disc.volume[i];
+    return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::damage(Vector &phi) const
+  {
+    const auto &nb = disc.neighborhood;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *w     = nb.bond_weight.data() + nb.table_start[i];
+        double              all = 0., intact = 0.;
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            all += w[b - begin];
+            if (!broken_flag[b])
+              intact += w[b - begin];
+          }
+        phi.local_element(i) = all > 0. ? 1. - intact / all : 0.;
+      }
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::break_bonds(
+    const std::function<bool(const Point<dim> &, const Point<dim> &)> &cuts)
+  {
+    const auto &nb = disc.neighborhood;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+        {
+          const std::int32_t j     = nb.col[b];
+          const bool         first = disc.id[i] < disc.id[j];
+          if (first ? cuts(disc.position[i], disc.position[j]) :
+                      cuts(disc.position[j], disc.position[i]))
+            broken_flag[b] = 1;
+        }
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::add_precrack(const Point<dim> &a, const Point<dim> &b)
+  {
+    if constexpr (dim != 2)
+      {
+        (void)a;
+        (void)b;
+        throw ParameterError("Pre-crack", "a line segment in " + std::to_string(dim) + "D",
+                             "line segments in 2D only (use break_bonds() otherwise)");
+      }
+    else
+      {
+        // Proper intersection by orientation signs: the segments cross iff
+        // each one's end points lie strictly on opposite sides of the other.
+        const auto orient = [](const Point<2> &p, const Point<2> &q, const Point<2> &r) {
+          return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+        };
+        break_bonds([&](const Point<2> &p, const Point<2> &q) {
+          return orient(a, b, p) * orient(a, b, q) < 0. && orient(p, q, a) * orient(p, q, b) < 0.;
+        });
+      }
+  }
+
+  template <int dim>
+  std::uint64_t
+  BondBasedOperator<dim>::n_broken_bonds() const
+  {
+    std::uint64_t n = 0;
+    for (const auto f : broken_flag)
+      n += f;
+    return Utilities::MPI::sum(n, disc.get_mpi_communicator());
+  }
+
+  template <int dim>
+  double
+  BondBasedOperator<dim>::critical_time_step(const double rho) const
+  {
+    double dt = std::numeric_limits<double>::max();
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (row_stiffness[i] > 0.)
+        dt = std::min(dt, std::sqrt(2. * rho / row_stiffness[i]));
+    return Utilities::MPI::min(dt, disc.get_mpi_communicator());
+  }
+
+  template class BondBasedOperator<1>;
+  template class BondBasedOperator<2>;
+  template class BondBasedOperator<3>;
+} // namespace PeriDEAL
