@@ -170,6 +170,22 @@ namespace PeriDEAL
 
     timer.restart();
     build_neighborhoods();
+    // Second balance by the actual bond count per cell (cells cut by the
+    // boundary or holding constraint-layer nodes have fewer bonds than the
+    // particle count suggests); then number, exchange and search again.
+    if (dim > 1 && Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
+      {
+        std::vector<unsigned int> bonds(triangulation->n_active_cells(), 0);
+        unsigned int              row = 0;
+        for (const auto &cell : triangulation->active_cell_iterators())
+          if (cell->is_locally_owned())
+            for (std::size_t k = 0; k < nodes_in_cell[cell->active_cell_index()].size(); ++k, ++row)
+              bonds[cell->active_cell_index()] +=
+                neighborhood.row_start[row + 1] - neighborhood.row_start[row];
+        repartition(bonds);
+        number_nodes_and_exchange_ghosts();
+        build_neighborhoods();
+      }
     setup_seconds[2] = timer.wall_time();
   }
 
@@ -336,24 +352,35 @@ namespace PeriDEAL
                     "(the body)", "a body that contains at least one lattice node; "
                                   "check the geometry and the grid spacing");
 
-    // Balance the bonds: every node of a cell carries about one stencil of
-    // bonds, so the particle count weights the cells.
+    // First balance: every node of a full family carries one stencil of
+    // bonds, so the particle count is a good first guess of the bond count.
+    std::vector<unsigned int> weights(triangulation->n_active_cells(), 0);
+    for (const auto &cell : triangulation->active_cell_iterators())
+      if (cell->is_locally_owned())
+        weights[cell->active_cell_index()] = particle_handler->n_particles_in_cell(cell);
+    repartition(weights);
+  }
+
+  template <int dim>
+  void
+  Discretization<dim>::repartition(const std::vector<unsigned int> &cell_weights)
+  {
     if constexpr (dim > 1)
       if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
         {
           auto &tria = dynamic_cast<parallel::distributed::Triangulation<dim> &>(*triangulation);
-          auto  connection = tria.signals.weight.connect(
+          // Weights are read during repartition() from the cells as they are
+          // before it; p4est wants unsigned int, so scale large counts down.
+          const unsigned int max_w =
+            Utilities::MPI::max(cell_weights.empty() ? 0u :
+                                                       *std::max_element(cell_weights.begin(),
+                                                                         cell_weights.end()),
+                                mpi_communicator);
+          const unsigned int divisor = 1 + max_w / 100000;
+          auto               connection = tria.signals.weight.connect(
             [&](const typename Triangulation<dim>::cell_iterator &cell,
-                const typename Triangulation<dim>::CellStatus     status) -> unsigned int {
-              unsigned int n = 0;
-              if (status == Triangulation<dim>::CELL_COARSEN)
-                {
-                  for (const auto &child : cell->child_iterators())
-                    n += particle_handler->n_particles_in_cell(child);
-                }
-              else
-                n = particle_handler->n_particles_in_cell(cell);
-              return 1 + 16 * n;
+                const typename Triangulation<dim>::CellStatus) -> unsigned int {
+              return 1 + cell_weights[cell->active_cell_index()] / divisor;
             });
           particle_handler->prepare_for_coarsening_and_refinement();
           tria.repartition();

@@ -533,6 +533,14 @@ end
         s.advance();
       check(Utilities::MPI::min(s.discretization().n_owned(), MPI_COMM_WORLD) > 0,
             "every rank owns nodes");
+      // Cells are weighted by their bond counts: the bonds per rank must be
+      // balanced up to the granularity of the octree's cells.
+      const double bonds    = s.discretization().neighborhood.n_bonds();
+      const double max_b    = Utilities::MPI::max(bonds, MPI_COMM_WORLD);
+      const double mean_b   = Utilities::MPI::sum(bonds, MPI_COMM_WORLD) /
+                            Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
+      check(max_b <= 1.1 * mean_b, "bond balance: max/mean bonds per rank = " +
+                                      std::to_string(max_b / mean_b) + " <= 1.1");
       std::vector<std::pair<types::particle_index, double>> mine;
       for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
         mine.emplace_back(s.discretization().id[i], s.solution().local_element(i));

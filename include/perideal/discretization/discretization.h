@@ -98,8 +98,9 @@ namespace PeriDEAL
    * triangulation whose cells are no smaller than the longest bond (delta +
    * dx/2 with partial volumes): a parallel::distributed::Triangulation
    * (p4est) in 2D/3D, a parallel::shared::Triangulation in 1D. Then owned
-   * plus ghost cells hold every neighbour of every owned node. Cells are
-   * weighted by their bond count when the mesh is repartitioned.
+   * plus ghost cells hold every neighbour of every owned node. The mesh is
+   * repartitioned twice: by particle count, then by the bond count of each
+   * cell found by the first neighbour search.
    *
    * After setup the hot data leave the particle handler: node positions,
    * volumes, ids and tags are structure-of-arrays in local numbering
@@ -235,6 +236,8 @@ namespace PeriDEAL
     create_background_mesh(const BoundingBox<dim> &box, const double min_cell_size);
     void
     insert_nodes(const Domain<dim> &domain);
+    void
+    repartition(const std::vector<unsigned int> &cell_weights);
     void
     number_nodes_and_exchange_ghosts();
     void
