@@ -8,7 +8,6 @@
 #   RANKS       MPI ranks per benchmark (default 1)
 #   CASES       cases to run (default "2d_m3 2d_m12 3d_m3 3d_m12")
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
-#   PROTOTYPES  0 to skip the prototype apply loops (default 1)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -56,7 +55,6 @@ elif [ "$ranks" != 1 ]; then
   exit 1
 fi
 extra=()
-[ "${PROTOTYPES:-1}" = 0 ] && extra+=(--no-prototypes)
 
 results="$build/benchmark-results.txt"
 : > "$results"
