@@ -14,6 +14,7 @@
 #include <perideal/io/checkpoint.h>
 #include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
+#include <perideal/time_stepping/mechanics_solver.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -47,11 +48,13 @@ namespace
   {
     prm.declare_entry("Dimension", "2", Patterns::Integer(1, 3),
                       "Spatial dimension of the run (1, 2 or 3).");
-    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion"),
-                      "The problem class; PD diffusion and bi-material corrosion "
-                      "(Model/Type) in this version.");
+    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics"),
+                      "diffusion: PD diffusion and bi-material corrosion (Model/Type); "
+                      "mechanics: dynamic bond-based PD with brittle fracture "
+                      "(Model/Bond-based, Mechanics).");
     // The entries do not depend on the dimension; declare them once.
     DiffusionRunParameters<2>::declare_parameters(prm);
+    MechanicsRunParameters<2>::declare_parameters(prm);
   }
 
   // A PNG of the time series.
@@ -73,26 +76,70 @@ namespace
     run_gnuplot(dir + "/plot.gp", gp, dir + "/time_series.png");
   }
 
+  // The parameter file used, next to the output.
+  void
+  write_used_parameters(const ParameterHandler &prm, const std::string &directory)
+  {
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      {
+        std::filesystem::create_directories(directory);
+        const std::string used = directory + "/parameters.prm";
+        std::ofstream     out(used + ".tmp");
+        prm.print_parameters(out, ParameterHandler::PRM);
+        out.close();
+        std::filesystem::rename(used + ".tmp", used);
+      }
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
+
+  template <int dim>
+  void
+  run_mechanics(ParameterHandler &prm, const unsigned int stop_after)
+  {
+    MechanicsRunParameters<dim> parameters;
+    parameters.parse_parameters(prm);
+    write_used_parameters(prm, parameters.output_directory);
+    MechanicsSolver<dim> solver(MPI_COMM_WORLD, parameters);
+    solver.setup();
+    solver.run(stop_after);
+    // Both are collective: evaluate them on every rank.
+    const double        energy = solver.total_energy();
+    const std::uint64_t broken = solver.model().n_broken_bonds();
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      {
+        std::cout << "Final: t = " << solver.integrator().time() << ", total energy = " << energy
+                  << ", broken bonds = " << broken << std::endl;
+        const std::string dir = parameters.output_directory;
+        const std::string csv = "'" + dir + "/time_series.csv'";
+        run_gnuplot(dir + "/plot.gp",
+                    gnuplot_png_preamble(dir + "/time_series.png") +
+                      "set datafile separator ','\nset key autotitle columnhead\n"
+                      "set xlabel 'time'\nset ylabel 'energy'\nplot " + csv +
+                      " using 1:2 with lines lw 2, '' using 1:3 with lines lw 2, '' using 1:4 "
+                      "with lines lw 2\n",
+                    dir + "/time_series.png");
+      }
+  }
+
   template <int dim>
   void
   run(ParameterHandler &prm, const bool resume, const unsigned int stop_after)
   {
+    if (prm.get("Problem") == "mechanics")
+      {
+        check_parameter(!resume, "command line", "--resume",
+                        "no --resume for Problem = mechanics (checkpoints are not "
+                        "implemented for it yet)");
+        run_mechanics<dim>(prm, stop_after);
+        return;
+      }
     DiffusionRunParameters<dim> parameters;
     parameters.parse_parameters(prm);
     if (resume)
       parameters.resume = true;
 
     const MPI_Comm comm = MPI_COMM_WORLD;
-    if (Utilities::MPI::this_mpi_process(comm) == 0)
-      {
-        std::filesystem::create_directories(parameters.output_directory);
-        const std::string used = parameters.output_directory + "/parameters.prm";
-        std::ofstream     out(used + ".tmp");
-        prm.print_parameters(out, ParameterHandler::PRM);
-        out.close();
-        std::filesystem::rename(used + ".tmp", used);
-      }
-    MPI_Barrier(comm);
+    write_used_parameters(prm, parameters.output_directory);
 
     DiffusionSolver<dim> solver(comm, parameters);
     solver.setup();

@@ -43,3 +43,9 @@ perideal_add_test(NAME driver.find_package
   COMMAND ${CMAKE_COMMAND} -DSOURCE=${_d}/outside_project -DBINARY=${CMAKE_BINARY_DIR}/tests/run/find_package/build
           -DPERIDEAL_DIR=${CMAKE_BINARY_DIR} -P ${_d}/outside_project/run.cmake
   LABELS unit)
+
+# Problem = mechanics through the driver on 2 ranks: the plate cracks.
+perideal_add_test(NAME driver.mechanics NPROCS 2 COMMAND ${_perideal} ${_d}/crack_plate.prm
+  LABELS "unit;mpi" TIMEOUT 300)
+set_tests_properties(driver.mechanics PROPERTIES
+  PASS_REGULAR_EXPRESSION "Final: t = 300, total energy = [0-9.e-]+, broken bonds = [1-9][0-9]*")

@@ -1,0 +1,162 @@
+#ifndef perideal_models_lps_h
+#define perideal_models_lps_h
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <perideal/base/kernel.h>
+#include <perideal/discretization/discretization.h>
+
+#include <array>
+#include <vector>
+
+namespace PeriDEAL
+{
+  /**
+   * Parameters of the linearized linear peridynamic solid (LPS, dissertation
+   * Sect. 2.1, (2.10)-(2.19)): the influence function and the 3D bulk and
+   * shear moduli K and G. In 2D the model is the plane-strain LPS (see
+   * LinearizedLPSOperator).
+   */
+  struct LPSModelParameters
+  {
+    /** Influence function omega. */
+    InfluenceFunction omega = InfluenceFunction::constant;
+    /** Bulk modulus K (> 0). */
+    double bulk_modulus = 1.;
+    /** Shear modulus G (> 0). */
+    double shear_modulus = 1.;
+
+    /** Declare the "Model" entries of the LPS model. */
+    static void
+    declare_parameters(ParameterHandler &prm);
+    /** Read and validate them (the caller has entered "Model"). */
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /**
+   * The linearized state-based LPS model on the standard meshfree scheme.
+   * With d = dim, the bond xi = x_j - x_i, the quadrature weight beta V_j of
+   * the Neighborhood table and omega = omega(min(|xi|, delta)):
+   *
+   * - weighted volume (2.15), computed per node from the discrete sum so
+   *   that the dilatation of a homogeneous deformation is exact for every
+   *   node with a full family:
+   *   @f[ m_i = \sum_j \omega |\xi|^2 \beta V_j @f]
+   * - linearized dilatation (2.19) with the linearized extension
+   *   e_ij = xi . (u_j - u_i) / |xi|:
+   *   @f[ \theta_i = \frac{d}{m_i} \sum_j \omega |\xi| e_{ij} \beta V_j @f]
+   * - strain energy density (2.14), with alpha_i = d (d+2) G / m_i:
+   *   @f[ W_i = \frac{K_d}{2} \theta_i^2 + \frac{\alpha_i}{2} \sum_j \omega
+   *      (e_{ij} - \theta_i |\xi| / d)^2 \beta V_j @f]
+   * - force density T_i<xi> - T_j<-xi> (2.18) with the scalar force state
+   *   t_ij = omega ((d K_d - (d+2) G) theta_i |xi| / m_i + alpha_i e_ij)
+   *   along xi/|xi|:
+   *   @f[ f_i = \sum_j \omega \Big[ (d K_d - (d+2) G)
+   *       \big(\tfrac{\theta_i}{m_i} + \tfrac{\theta_j}{m_j}\big) \xi
+   *     + d (d+2) G \big(\tfrac{1}{m_i} + \tfrac{1}{m_j}\big)
+   *       \frac{\xi \otimes \xi}{|\xi|^2} (u_j - u_i) \Big] \beta V_j @f]
+   *   (t is dW/de; the theta-derivative of the deviatoric part vanishes
+   *   because sum_j omega |xi| (e - theta |xi|/d) beta V_j = 0 exactly with
+   *   the discrete m_i).
+   *
+   * 3D (d = 3, K_3 = K): the factors are 3/m, 3K - 5G and 15G/m of (2.18)-(2.19).
+   * 2D is the plane-strain LPS: d = 2 and K_2 = K + G/3 = lambda + mu, the
+   * 2D bulk modulus of plane strain, so that the 2D factors are 2/m,
+   * 2K - 10G/3 and 8G/m and the energy of a homogeneous in-plane strain H
+   * is K_2 tr(H)^2/2 + G |H - tr(H) I/2|^2 = the plane-strain CCM energy
+   * K tr(H)^2/2 + G |dev_3D H|^2. These constants follow from the angular
+   * averages <n_a n_b> = delta_ab / d and <(n.D n)^2> = 2|D|^2/(d(d+2)) of a
+   * traceless D. Under m-refinement the force converges to the Navier
+   * operator (K + G/3) grad div u + G Laplace u in both cases. 1D is not
+   * provided.
+   *
+   * theta_j of ghost neighbours is needed: compute_forces() computes theta
+   * on the owned nodes and updates its ghosts before the force pass; m_j of
+   * the ghosts is exchanged once in the constructor.
+   */
+  template <int dim>
+  class LinearizedLPSOperator
+  {
+    static_assert(dim == 2 || dim == 3, "LinearizedLPSOperator: 2D (plane strain) or 3D");
+
+  public:
+    /** A displacement or force field: one node Vector per component. */
+    using VectorField = std::array<Vector, dim>;
+
+    LinearizedLPSOperator(const Discretization<dim> &discretization,
+                          const LPSModelParameters  &parameters);
+
+    /** The discretization. */
+    const Discretization<dim> &
+    discretization() const
+    {
+      return disc;
+    }
+
+    /** K_d: K in 3D, K + G/3 in 2D (plane strain). */
+    double
+    dimensional_bulk_modulus() const
+    {
+      return K_d;
+    }
+
+    /** Shear modulus G. */
+    double
+    shear_modulus() const
+    {
+      return G;
+    }
+
+    /** The discrete weighted volume m_i (owned and ghost entries valid). */
+    const Vector &
+    weighted_volume() const
+    {
+      return m;
+    }
+
+    /** Zero-initialized dim node Vectors. */
+    void
+    initialize(VectorField &field) const;
+
+    /**
+     * theta_i (2.19) of the owned nodes; @p u must have up-to-date ghost
+     * values. Ghost entries of @p theta are not updated.
+     */
+    void
+    compute_dilatation(const VectorField &u, Vector &theta) const;
+
+    /**
+     * force_i = f_i (force per unit volume) of the owned nodes. @p u must have
+     * up-to-date ghost values. Computes theta (kept, see dilatation()) and
+     * exchanges its ghost values (collective).
+     */
+    void
+    compute_forces(const VectorField &u, VectorField &force);
+
+    /** theta of the last compute_forces() (owned and ghost entries). */
+    const Vector &
+    dilatation() const
+    {
+      return theta;
+    }
+
+    /** W_i (2.14) of the owned nodes; @p u must have up-to-date ghost values. */
+    void
+    strain_energy_density(const VectorField &u, Vector &W) const;
+
+    /** sum_i W_i V_i over all ranks. */
+    double
+    total_strain_energy(const VectorField &u) const;
+
+  private:
+    const Discretization<dim> &disc;
+    double                     K_d, G;
+    /** omega(min(|xi|, delta)) beta V_j per table entry. */
+    std::vector<double> bond_coefficient;
+    Vector              m;
+    Vector              theta;
+  };
+} // namespace PeriDEAL
+
+#endif

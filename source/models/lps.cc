@@ -1,0 +1,190 @@
+#include <deal.II/base/mpi.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/models/lps.h>
+
+#include <cmath>
+
+namespace PeriDEAL
+{
+  void
+  LPSModelParameters::declare_parameters(ParameterHandler &prm)
+  {
+    prm.declare_entry("Influence function", "constant", Patterns::Selection("constant|linear"),
+                      "omega_0 = 1 (2.12) or omega_1 = 1 - r/delta (2.13).");
+    prm.declare_entry("Bulk modulus", "1", Patterns::Double(), "K (> 0).");
+    prm.declare_entry("Shear modulus", "1", Patterns::Double(), "G (> 0).");
+  }
+
+  void
+  LPSModelParameters::parse_parameters(ParameterHandler &prm)
+  {
+    omega         = parse_influence_function(prm.get("Influence function"), "Model/Influence function");
+    bulk_modulus  = prm.get_double("Bulk modulus");
+    shear_modulus = prm.get_double("Shear modulus");
+    check_parameter(bulk_modulus > 0., "Model/Bulk modulus", bulk_modulus, "a positive number");
+    check_parameter(shear_modulus > 0., "Model/Shear modulus", shear_modulus, "a positive number");
+  }
+
+  template <int dim>
+  LinearizedLPSOperator<dim>::LinearizedLPSOperator(const Discretization<dim> &discretization,
+                                                    const LPSModelParameters  &p)
+    : disc(discretization)
+    , K_d(dim == 3 ? p.bulk_modulus : p.bulk_modulus + p.shear_modulus / 3.)
+    , G(p.shear_modulus)
+  {
+    const auto  &nb    = disc.neighborhood;
+    const double delta = disc.parameters().delta;
+    // omega at min(r, delta): bonds of the partial-volume shell beyond delta
+    // keep the horizon value, weighted by beta (as in the bond-based model).
+    bond_coefficient.resize(nb.bond_length.size());
+    for (std::size_t t = 0; t < bond_coefficient.size(); ++t)
+      bond_coefficient[t] =
+        influence(p.omega, std::min(nb.bond_length[t], delta), delta) * nb.bond_weight[t];
+
+    disc.initialize_vector(m);
+    disc.initialize_vector(theta);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double *coef = bond_coefficient.data() + nb.table_start[i];
+        const double *len  = nb.bond_length.data() + nb.table_start[i];
+        double        s    = 0.;
+        for (std::uint64_t k = 0; k < nb.row_start[i + 1] - nb.row_start[i]; ++k)
+          s += coef[k] * len[k] * len[k];
+        m.local_element(i) = s;
+      }
+    m.update_ghost_values();
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::initialize(VectorField &field) const
+  {
+    for (auto &v : field)
+      disc.initialize_vector(v);
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::compute_dilatation(const VectorField &u, Vector &th) const
+  {
+    const auto                    &nb = disc.neighborhood;
+    const std::vector<Point<dim>> &x  = disc.position;
+    std::array<const double *, dim> ud;
+    for (unsigned int d = 0; d < dim; ++d)
+      ud[d] = u[d].begin();
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *coef  = bond_coefficient.data() + nb.table_start[i];
+        double              s     = 0.;
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            const std::int32_t j  = nb.col[b];
+            double             xe = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              xe += (x[j][d] - x[i][d]) * (ud[d][j] - ud[d][i]);
+            s += coef[b - begin] * xe;
+          }
+        const double mi     = m.local_element(i);
+        th.local_element(i) = mi > 0. ? dim * s / mi : 0.;
+      }
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::compute_forces(const VectorField &u, VectorField &force)
+  {
+    compute_dilatation(u, theta);
+    theta.update_ghost_values();
+
+    const auto                    &nb = disc.neighborhood;
+    const std::vector<Point<dim>> &x  = disc.position;
+    std::array<const double *, dim> ud;
+    for (unsigned int d = 0; d < dim; ++d)
+      ud[d] = u[d].begin();
+    const double *md = m.begin();
+    const double *td = theta.begin();
+    // Volumetric factor d K_d - (d+2) G and deviatoric factor d (d+2) G.
+    const double a_vol = dim * K_d - (dim + 2.) * G;
+    const double a_dev = dim * (dim + 2.) * G;
+
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *coef  = bond_coefficient.data() + nb.table_start[i];
+        const double        inv_mi = md[i] > 0. ? 1. / md[i] : 0.;
+        const double        q_i    = td[i] * inv_mi;
+        double              f[dim] = {};
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            const std::int32_t j = nb.col[b];
+            double             xi[dim], r2 = 0., xe = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                xi[d] = x[j][d] - x[i][d];
+                r2 += xi[d] * xi[d];
+                xe += xi[d] * (ud[d][j] - ud[d][i]);
+              }
+            const double inv_mj = md[j] > 0. ? 1. / md[j] : 0.;
+            const double scale =
+              coef[b - begin] * (a_vol * (q_i + td[j] * inv_mj) + a_dev * (inv_mi + inv_mj) * xe / r2);
+            for (unsigned int d = 0; d < dim; ++d)
+              f[d] += scale * xi[d];
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          force[d].local_element(i) = f[d];
+      }
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::strain_energy_density(const VectorField &u, Vector &W) const
+  {
+    Vector th;
+    disc.initialize_vector(th);
+    compute_dilatation(u, th);
+    const auto &nb = disc.neighborhood;
+    const auto &x  = disc.position;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *coef  = bond_coefficient.data() + nb.table_start[i];
+        const double        ti    = th.local_element(i);
+        const double        mi    = m.local_element(i);
+        double              w     = 0.;
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            const std::int32_t j  = nb.col[b];
+            double             r2 = 0., xe = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double xi = x[j][d] - x[i][d];
+                r2 += xi * xi;
+                xe += xi * (u[d].local_element(j) - u[d].local_element(i));
+              }
+            const double r  = std::sqrt(r2);
+            const double ed = xe / r - ti * r / dim;
+            w += coef[b - begin] * ed * ed;
+          }
+        const double alpha = mi > 0. ? dim * (dim + 2.) * G / mi : 0.;
+        W.local_element(i) = 0.5 * K_d * ti * ti + 0.5 * alpha * w;
+      }
+  }
+
+  template <int dim>
+  double
+  LinearizedLPSOperator<dim>::total_strain_energy(const VectorField &u) const
+  {
+    Vector W;
+    disc.initialize_vector(W);
+    strain_energy_density(u, W);
+    double e = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      e += W.local_element(i) * disc.volume[i];
+    return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+  }
+
+  template class LinearizedLPSOperator<2>;
+  template class LinearizedLPSOperator<3>;
+} // namespace PeriDEAL

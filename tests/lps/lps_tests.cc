@@ -1,0 +1,463 @@
+// Tests of the linearized LPS operator (dissertation (2.14)-(2.19)):
+// homogeneous strains (exact dilatation, zero force, energy vs the CCM
+// value), rigid motions, convergence of the force of a quadratic field to
+// the Navier operator, and rank-count invariance.
+
+#include <perideal/discretization/discretization.h>
+#include <perideal/models/lps.h>
+
+#include "../check.h"
+
+#include <map>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  std::string
+  sci(const double x)
+  {
+    std::ostringstream s;
+    s.precision(3);
+    s << std::scientific << x;
+    return s.str();
+  }
+
+  const double K = 2.1, G = 0.9;
+
+  // A ball of radius 2 delta + 2 dx around the origin, a lattice node: the
+  // nodes with |x| <= dx ("deep") have neighbours whose families are all
+  // full, so m_j = m_i and theta_j is exact there.
+  template <int dim>
+  std::unique_ptr<Discretization<dim>>
+  make_ball(const MPI_Comm comm, const unsigned int m, const double delta = 1.)
+  {
+    const double      dx = delta / m;
+    LatticeParameters lp;
+    lp.dx    = dx;
+    lp.delta = delta;
+    auto disc = std::make_unique<Discretization<dim>>(comm);
+    disc->setup(BallDomain<dim>(Point<dim>(), 2. * delta + 2. * dx), lp);
+    return disc;
+  }
+
+  template <int dim>
+  bool
+  deep(const Discretization<dim> &disc, const unsigned int i)
+  {
+    return disc.position[i].norm() <= disc.parameters().dx * (1. + 1e-9);
+  }
+
+  template <int dim>
+  bool
+  full_family(const Discretization<dim> &disc, const unsigned int i)
+  {
+    const auto &nb = disc.neighborhood;
+    return nb.table_start[i] == 0 && nb.row_start[i + 1] - nb.row_start[i] == nb.stencil_size;
+  }
+
+  template <int dim>
+  void
+  set_field(const Discretization<dim>                                    &disc,
+            const std::function<Tensor<1, dim>(const Point<dim> &)> &u_of_x,
+            typename LinearizedLPSOperator<dim>::VectorField              &u)
+  {
+    for (unsigned int i = 0; i < disc.n_owned() + disc.n_ghost(); ++i)
+      {
+        const auto v = u_of_x(disc.position[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          u[d].local_element(i) = v[d];
+      }
+  }
+
+  template <int dim>
+  Tensor<2, dim>
+  strain(const bool symmetric)
+  {
+    const double   a[3][3] = {{1.3, 0.4, -0.7}, {0.2, -0.5, 0.9}, {0.6, -0.3, 0.8}};
+    Tensor<2, dim> H;
+    for (unsigned int r = 0; r < dim; ++r)
+      for (unsigned int c = 0; c < dim; ++c)
+        H[r][c] = 1e-3 * (symmetric ? 0.5 * (a[r][c] + a[c][r]) : 0.5 * (a[r][c] - a[c][r]));
+    return H;
+  }
+
+  std::string
+  tag(const unsigned int dim, const InfluenceFunction omega, const unsigned int m)
+  {
+    return std::to_string(dim) + "D " + to_string(omega) + " m = " + std::to_string(m) + ": ";
+  }
+
+  // u = H x, H symmetric. theta = tr H to round-off at full-family nodes
+  // (m_i is the discrete sum); the force vanishes at deep nodes (symmetric
+  // stencil, equal m_j and theta_j); W at the centre approaches the CCM
+  // value K tr(H)^2/2 + G |dev H|^2 (plane strain in 2D) with the lattice
+  // quadrature error of the 4th moment, returned.
+  template <int dim>
+  double
+  homogeneous_case(const unsigned int m, const InfluenceFunction omega)
+  {
+    const auto         disc = make_ball<dim>(MPI_COMM_WORLD, m);
+    LPSModelParameters p;
+    p.omega         = omega;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<dim>                       op(*disc, p);
+    typename LinearizedLPSOperator<dim>::VectorField u, f;
+    op.initialize(u);
+    op.initialize(f);
+    const Tensor<2, dim> H = strain<dim>(true);
+    set_field<dim>(*disc, [&](const Point<dim> &x) { return H * x; }, u);
+    op.compute_forces(u, f);
+    PeriDEAL::Vector W;
+    disc->initialize_vector(W);
+    op.strain_energy_density(u, W);
+
+    const double   tr = trace(H);
+    Tensor<2, dim> dev3 = H;
+    for (unsigned int d = 0; d < dim; ++d)
+      dev3[d][d] -= tr / 3.;
+    // 3D deviator; in 2D the out-of-plane entry -tr/3 is added.
+    const double W_ccm = 0.5 * K * tr * tr + G * (dev3.norm_square() + (dim == 2 ? tr * tr / 9. : 0.));
+    // Force scale: (K + G) |H| / delta (delta = 1).
+    const double f_scale = (K + G) * H.norm();
+
+    double theta_err = 0., f_max = 0., w_err = -1.;
+    unsigned int n_full = 0, n_deep = 0;
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      {
+        if (full_family(*disc, i))
+          {
+            ++n_full;
+            theta_err = std::max(theta_err, std::abs(op.dilatation().local_element(i) - tr));
+          }
+        if (deep(*disc, i))
+          {
+            ++n_deep;
+            double n = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              n += f[d].local_element(i) * f[d].local_element(i);
+            f_max = std::max(f_max, std::sqrt(n));
+            if (disc->position[i].norm() < 1e-12)
+              w_err = std::abs(W.local_element(i) - W_ccm) / W_ccm;
+          }
+      }
+    theta_err = Utilities::MPI::max(theta_err, MPI_COMM_WORLD);
+    f_max     = Utilities::MPI::max(f_max, MPI_COMM_WORLD);
+    w_err     = Utilities::MPI::max(w_err, MPI_COMM_WORLD);
+    n_full    = Utilities::MPI::sum(n_full, MPI_COMM_WORLD);
+    n_deep    = Utilities::MPI::sum(n_deep, MPI_COMM_WORLD);
+    const std::string t = tag(dim, omega, m);
+    check(n_full > 0 && n_deep == (2 * dim + 1), t + std::to_string(n_full) + " full-family nodes, " +
+                                                   std::to_string(n_deep) + " deep nodes");
+    check(theta_err <= 1e-12 * std::abs(tr), t + "max |theta - tr H| = " + sci(theta_err) +
+                                               " (tr H = " + sci(tr) + ")");
+    check(f_max <= 1e-11 * f_scale, t + "max |f| at deep nodes = " + sci(f_max) + " (scale (K+G)|H|/delta = " +
+                                      sci(f_scale) + ")");
+    return w_err;
+  }
+
+  void
+  homogeneous()
+  {
+    for (const auto omega : {InfluenceFunction::constant, InfluenceFunction::linear})
+      {
+        double previous = 1.;
+        for (const unsigned int m : {3u, 6u, 12u})
+          {
+            const double e = homogeneous_case<2>(m, omega);
+            check(e >= 0. && e < previous && (m < 6 || e < 0.05),
+                  tag(2, omega, m) + "relative energy error vs CCM " + sci(e));
+            previous = e;
+          }
+      }
+    for (const auto omega : {InfluenceFunction::constant, InfluenceFunction::linear})
+      {
+        double previous = 1.;
+        for (const unsigned int m : {3u, 6u})
+          {
+            const double e = homogeneous_case<3>(m, omega);
+            check(e >= 0. && e < previous && (m < 6 || e < 0.05),
+                  tag(3, omega, m) + "relative energy error vs CCM " + sci(e));
+            previous = e;
+          }
+      }
+  }
+
+  // Translation and infinitesimal rotation (H antisymmetric): theta and the
+  // force vanish at every node, including the boundary ones.
+  template <int dim>
+  void
+  rigid_case(const InfluenceFunction omega)
+  {
+    const auto         disc = make_ball<dim>(MPI_COMM_WORLD, 3);
+    LPSModelParameters p;
+    p.omega         = omega;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<dim>                       op(*disc, p);
+    typename LinearizedLPSOperator<dim>::VectorField u, f;
+    op.initialize(u);
+    op.initialize(f);
+    const Tensor<2, dim> Wr = strain<dim>(false);
+    Tensor<1, dim>       c;
+    for (unsigned int d = 0; d < dim; ++d)
+      c[d] = 1e-3 * (d + 1.);
+    for (const bool rotation : {false, true})
+      {
+        set_field<dim>(*disc, [&](const Point<dim> &x) { return rotation ? Tensor<1, dim>(Wr * x) : c; }, u);
+        op.compute_forces(u, f);
+        double th = 0., fm = 0.;
+        for (unsigned int i = 0; i < disc->n_owned(); ++i)
+          {
+            th = std::max(th, std::abs(op.dilatation().local_element(i)));
+            for (unsigned int d = 0; d < dim; ++d)
+              fm = std::max(fm, std::abs(f[d].local_element(i)));
+          }
+        th = Utilities::MPI::max(th, MPI_COMM_WORLD);
+        fm = Utilities::MPI::max(fm, MPI_COMM_WORLD);
+        const double      scale = rotation ? Wr.norm() : c.norm();
+        const std::string t = std::to_string(dim) + "D " + to_string(omega) +
+                              (rotation ? " rotation: " : " translation: ");
+        check(th <= 1e-13 * scale, t + "max |theta| = " + sci(th));
+        check(fm <= 1e-12 * (K + G) * scale, t + "max |f| = " + sci(fm));
+      }
+  }
+
+  void
+  rigid_motion()
+  {
+    for (const auto omega : {InfluenceFunction::constant, InfluenceFunction::linear})
+      {
+        rigid_case<2>(omega);
+        rigid_case<3>(omega);
+      }
+  }
+
+  // u_a = 1/2 Q_abc x_b x_c: the Navier operator is the constant
+  // L_a = (K + G/3) Q_bba + G Q_abb. Relative error of f at the centre.
+  template <int dim>
+  double
+  navier_error(const unsigned int m, const InfluenceFunction omega)
+  {
+    const auto         disc = make_ball<dim>(MPI_COMM_WORLD, m);
+    LPSModelParameters p;
+    p.omega         = omega;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<dim>                       op(*disc, p);
+    typename LinearizedLPSOperator<dim>::VectorField u, f;
+    op.initialize(u);
+    op.initialize(f);
+    double Q[3][3][3];
+    for (unsigned int a = 0; a < 3; ++a)
+      for (unsigned int b = 0; b < 3; ++b)
+        for (unsigned int c = b; c < 3; ++c)
+          Q[a][b][c] = Q[a][c][b] = 1e-3 * std::sin(1. + a + 2. * b + 3.7 * c);
+    set_field<dim>(*disc,
+                   [&](const Point<dim> &x) {
+                     Tensor<1, dim> v;
+                     for (unsigned int a = 0; a < dim; ++a)
+                       for (unsigned int b = 0; b < dim; ++b)
+                         for (unsigned int c = 0; c < dim; ++c)
+                           v[a] += 0.5 * Q[a][b][c] * x[b] * x[c];
+                     return v;
+                   },
+                   u);
+    op.compute_forces(u, f);
+    Tensor<1, dim> L;
+    for (unsigned int a = 0; a < dim; ++a)
+      for (unsigned int b = 0; b < dim; ++b)
+        L[a] += (K + G / 3.) * Q[b][b][a] + G * Q[a][b][b];
+    double err = -1.;
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      if (disc->position[i].norm() < 1e-12)
+        {
+          Tensor<1, dim> fi;
+          for (unsigned int d = 0; d < dim; ++d)
+            fi[d] = f[d].local_element(i);
+          err = (fi - L).norm() / L.norm();
+        }
+    return Utilities::MPI::max(err, MPI_COMM_WORLD);
+  }
+
+  void
+  navier()
+  {
+    for (const auto omega : {InfluenceFunction::constant, InfluenceFunction::linear})
+      {
+        double previous = 1.;
+        for (const unsigned int m : {3u, 6u, 12u})
+          {
+            const double e = navier_error<2>(m, omega);
+            check(e >= 0. && e < previous && (m < 12 || e < 1e-3), tag(2, omega, m) + "relative error of f vs Navier " + sci(e));
+            previous = e;
+          }
+        previous = 1.;
+        for (const unsigned int m : {3u, 6u})
+          {
+            const double e = navier_error<3>(m, omega);
+            check(e >= 0. && e < previous && (m < 6 || e < 5e-3), tag(3, omega, m) + "relative error of f vs Navier " + sci(e));
+            previous = e;
+          }
+      }
+  }
+
+  // Forces of a smooth pseudo-random field on comm, keyed by node id
+  // (complete on rank 0 of comm).
+  template <int dim>
+  std::map<types::particle_index, std::array<double, 3>>
+  random_forces(const MPI_Comm comm)
+  {
+    LatticeParameters lp;
+    lp.dx    = 0.1;
+    lp.delta = 0.3;
+    Point<dim> upper;
+    for (unsigned int d = 0; d < dim; ++d)
+      upper[d] = dim == 2 ? 2. : 1.;
+    Discretization<dim> disc(comm);
+    disc.setup(BoxDomain<dim>(Point<dim>(), upper), lp);
+    LPSModelParameters p;
+    p.omega         = InfluenceFunction::linear;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<dim>                       op(disc, p);
+    typename LinearizedLPSOperator<dim>::VectorField u, f;
+    op.initialize(u);
+    op.initialize(f);
+    set_field<dim>(disc,
+                   [](const Point<dim> &x) {
+                     Tensor<1, dim> v;
+                     for (unsigned int a = 0; a < dim; ++a)
+                       for (unsigned int b = 0; b < dim; ++b)
+                         v[a] += 1e-3 * std::sin(0.7 + 1.9 * a + 2.3 * b + (1.3 + a + 0.4 * b) * x[b]);
+                     return v;
+                   },
+                   u);
+    op.compute_forces(u, f);
+    check(Utilities::MPI::min(disc.n_owned(), comm) > 0 &&
+            (Utilities::MPI::n_mpi_processes(comm) == 1 || Utilities::MPI::max(disc.n_ghost(), comm) > 0),
+          std::to_string(dim) + "D: every rank owns nodes (" + std::to_string(Utilities::MPI::n_mpi_processes(comm)) +
+            " ranks)");
+    std::vector<std::pair<types::particle_index, std::array<double, 3>>> mine;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        std::array<double, 3> v{{0., 0., 0.}};
+        for (unsigned int d = 0; d < dim; ++d)
+          v[d] = f[d].local_element(i);
+        mine.emplace_back(disc.id[i], v);
+      }
+    std::map<types::particle_index, std::array<double, 3>> result;
+    for (const auto &part : Utilities::MPI::gather(comm, mine, 0))
+      for (const auto &e : part)
+        result[e.first] = e.second;
+    return result;
+  }
+
+  template <int dim>
+  void
+  rank_invariance_case()
+  {
+    const auto world = random_forces<dim>(MPI_COMM_WORLD);
+    // (every rank of MPI_COMM_WORLD owns nodes: checked in random_forces)
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) != 0)
+      return;
+    const auto   self = random_forces<dim>(MPI_COMM_SELF);
+    double       diff = 0., fmax = 0.;
+    unsigned int matched = 0;
+    for (const auto &e : self)
+      {
+        const auto it = world.find(e.first);
+        if (it == world.end())
+          continue;
+        ++matched;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            diff = std::max(diff, std::abs(it->second[d] - e.second[d]));
+            fmax = std::max(fmax, std::abs(e.second[d]));
+          }
+      }
+    const std::string t = std::to_string(dim) + "D " +
+                          std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) + " ranks vs 1: ";
+    check(matched == self.size() && matched == world.size() && matched > 0,
+          t + std::to_string(matched) + " nodes matched");
+    check(diff <= 1e-12 * fmax, t + "max |f diff| = " + sci(diff) + " (max |f| " + sci(fmax) + ")");
+  }
+
+  // The force is minus the gradient of the total energy E = sum_i W_i V_i
+  // (uniform V_i, symmetric beta): E is quadratic, so for a random field u
+  // and direction v, E(u + v) - E(u - v) = -2 sum_i f_i(u) . v_i V_i exactly.
+  // Checked on a box (boundary nodes included, where m_j != m_i).
+  template <int dim>
+  void
+  energy_gradient_case()
+  {
+    LatticeParameters lp;
+    lp.dx    = 0.1;
+    lp.delta = 0.3;
+    Point<dim> upper;
+    for (unsigned int d = 0; d < dim; ++d)
+      upper[d] = 1.;
+    Discretization<dim> disc(MPI_COMM_WORLD);
+    disc.setup(BoxDomain<dim>(Point<dim>(), upper), lp);
+    LPSModelParameters p;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<dim>                       op(disc, p);
+    typename LinearizedLPSOperator<dim>::VectorField u, v, w, f;
+    op.initialize(u);
+    op.initialize(v);
+    op.initialize(w);
+    op.initialize(f);
+    auto field = [](const Point<dim> &x, const double s) {
+      Tensor<1, dim> r;
+      for (unsigned int a = 0; a < dim; ++a)
+        for (unsigned int b = 0; b < dim; ++b)
+          r[a] += 1e-3 * std::sin(s + 1.9 * a + 2.3 * b + (3.1 + a + 0.4 * b + s) * x[b]);
+      return r;
+    };
+    set_field<dim>(disc, [&](const Point<dim> &x) { return field(x, 0.3); }, u);
+    set_field<dim>(disc, [&](const Point<dim> &x) { return field(x, 1.7); }, v);
+    op.compute_forces(u, f);
+    double work = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      for (unsigned int d = 0; d < dim; ++d)
+        work += f[d].local_element(i) * v[d].local_element(i) * disc.volume[i];
+    work = Utilities::MPI::sum(work, MPI_COMM_WORLD);
+    double e[2];
+    for (const int sign : {1, -1})
+      {
+        set_field<dim>(disc, [&](const Point<dim> &x) { return field(x, 0.3) + sign * field(x, 1.7); }, w);
+        e[sign > 0 ? 0 : 1] = op.total_strain_energy(w);
+      }
+    check_close(e[0] - e[1], -2. * work, 1e-10,
+                std::to_string(dim) + "D: E(u+v) - E(u-v) vs -2 sum f(u).v V");
+  }
+
+  void
+  energy_gradient()
+  {
+    energy_gradient_case<2>();
+    energy_gradient_case<3>();
+  }
+
+  void
+  rank_invariance()
+  {
+    rank_invariance_case<2>();
+    rank_invariance_case<3>();
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv,
+             {{"homogeneous", homogeneous},
+              {"rigid_motion", rigid_motion},
+              {"navier", navier},
+              {"energy_gradient", energy_gradient},
+              {"rank_invariance", rank_invariance}});
+}

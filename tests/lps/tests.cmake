@@ -1,0 +1,9 @@
+perideal_add_test_program(lps_tests ${CMAKE_CURRENT_LIST_DIR}/lps_tests.cc)
+
+foreach(_t homogeneous rigid_motion navier energy_gradient)
+  perideal_add_test(NAME lps.${_t} COMMAND $<TARGET_FILE:lps_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME lps.homogeneous.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:lps_tests> homogeneous LABELS "unit;mpi")
+perideal_add_test(NAME lps.rank_invariance.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:lps_tests> rank_invariance LABELS mpi)
