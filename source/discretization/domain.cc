@@ -7,6 +7,7 @@
 #include <deal.II/grid/grid_tools.h>
 
 #include <perideal/base/exceptions.h>
+#include <perideal/base/expressions.h>
 #include <perideal/discretization/domain.h>
 
 #include <fstream>
@@ -246,14 +247,9 @@ namespace PeriDEAL
   {
     try
       {
-        std::map<std::string, double> constants{{"pi", M_PI}};
-        if (dim < 3)
-          constants["z"] = 0.;
-        if (dim < 2)
-          constants["y"] = 0.;
         function.initialize(FunctionParser<dim>::default_variable_names(),
                             expression,
-                            constants);
+                            expression_constants(dim));
       }
     catch (...)
       {

@@ -4,6 +4,7 @@
 #include <deal.II/lac/trilinos_solver.h>
 
 #include <perideal/base/exceptions.h>
+#include <perideal/base/expressions.h>
 #include <perideal/io/checkpoint.h>
 #include <perideal/io/node_output.h>
 #include <perideal/io/time_series.h>
@@ -161,13 +162,7 @@ namespace PeriDEAL
                   const std::string   &constants,
                   const std::string   &parameter)
     {
-      std::map<std::string, double> c;
-      c["pi"] = M_PI;
-      // One expression serves every dimension: missing coordinates are 0.
-      if (dim < 3)
-        c["z"] = 0.;
-      if (dim < 2)
-        c["y"] = 0.;
+      std::map<std::string, double> c = expression_constants(dim);
       for (const auto &entry : Utilities::split_string_list(constants, ','))
         {
           const auto kv = Utilities::split_string_list(entry, '=');

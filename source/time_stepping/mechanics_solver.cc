@@ -2,6 +2,7 @@
 #include <deal.II/base/timer.h>
 
 #include <perideal/base/exceptions.h>
+#include <perideal/base/expressions.h>
 #include <perideal/io/node_output.h>
 #include <perideal/io/time_series.h>
 #include <perideal/time_stepping/mechanics_solver.h>
@@ -18,18 +19,13 @@ namespace PeriDEAL
     std::unique_ptr<FunctionParser<dim>>
     vector_function(const std::string &text, const std::string &parameter)
     {
-      auto                          f = std::make_unique<FunctionParser<dim>>(dim);
-      std::map<std::string, double> constants{{"pi", M_PI}};
-      if (dim < 3)
-        constants["z"] = 0.;
-      if (dim < 2)
-        constants["y"] = 0.;
+      auto       f     = std::make_unique<FunctionParser<dim>>(dim);
       const auto parts = Utilities::split_string_list(text, ';');
       check_parameter(parts.size() == dim, parameter, text,
                       std::to_string(dim) + " expressions separated by ';'");
       try
         {
-          f->initialize(FunctionParser<dim>::default_variable_names() + ",t", parts, constants, true);
+          f->initialize(FunctionParser<dim>::default_variable_names() + ",t", parts, expression_constants(dim), true);
           f->value(Point<dim>(), 0);
         }
       catch (std::exception &)
