@@ -21,8 +21,8 @@ top="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${BUILD_DIR:-$top/build-bench}"
 jobs="${JOBS:-$(nproc)}"
 ranks="${RANKS:-1}"
-cases="${CASES:-2d_m3 2d_m12 3d_m3 3d_m12}"
-pmb_cases="${PMB_CASES:-2d_m3 2d_m12 2d_m24 3d_m3 3d_m12}"
+cases="${CASES-2d_m3 2d_m12 3d_m3 3d_m12}"
+pmb_cases="${PMB_CASES-2d_m3 2d_m12 2d_m24 3d_m3 3d_m12}"
 pmb_3d_steps="${PMB_3D_STEPS:-50}"
 use_lammps="${LAMMPS:-1}"
 loop_seconds="${SECONDS_PER_LOOP:-1}"
@@ -114,7 +114,7 @@ if [ "$use_lammps" = 1 ]; then
     { apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y lammps lammps-examples; } \
       > "$build/lammps-install.log" 2>&1 || echo "run-all: LAMMPS installation failed" >&2
   fi
-  command -v lmp > /dev/null && lmp -h | grep -q "peri/pmb" && lammps_ok=1
+  command -v lmp > /dev/null && lmp -h 2> /dev/null | grep "peri/pmb" > /dev/null && lammps_ok=1
   [ "$lammps_ok" = 1 ] || echo "run-all: no lmp with peri/pmb; LAMMPS comparison skipped" >&2
 fi
 

@@ -273,9 +273,10 @@ namespace PeriDEAL
 
     /**
      * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
-     * one accumulator per component reduced once per row. The lanes do the
-     * same correctly rounded operations as pmb_row() (sqrt, div, fma), so
-     * both copies of a bond still see the same l and break together.
+     * one accumulator per component reduced once per row. Every bond goes
+     * through the same instructions (1/l from vrsqrt14pd and Newton steps,
+     * a few ulp from 1/sqrt), so the two copies of a bond still see
+     * bitwise the same l and break together.
      */
     template <int dim>
     inline void
@@ -292,7 +293,8 @@ namespace PeriDEAL
       __m512d acc[dim];
       for (unsigned int d = 0; d < dim; ++d)
         acc[d] = _mm512_setzero_pd();
-      const __m512d vs0 = _mm512_set1_pd(s0);
+      const __m512d vs0 = _mm512_set1_pd(s0), half = _mm512_set1_pd(0.5),
+                    three_halves = _mm512_set1_pd(1.5);
       for (unsigned int b = 0; b < n; b += 8)
         {
           const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
@@ -305,15 +307,22 @@ namespace PeriDEAL
           __m512d l2 = _mm512_mul_pd(y[0], y[0]);
           for (unsigned int d = 1; d < dim; ++d)
             l2 = _mm512_fmadd_pd(y[d], y[d], l2);
-          // Lanes that are masked off or broken: l = 1 keeps the division finite.
-          const __m512d l  = _mm512_mask_sqrt_pd(_mm512_set1_pd(1.), alive, l2);
+          // 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton steps
+          // inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is the
+          // bottleneck of sqrt + div (doc/benchmarks.md). Masked-off and
+          // broken lanes get l2 = 1 to keep inv finite.
+          l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
+          const __m512d h = _mm512_mul_pd(half, l2);
+          __m512d       inv = _mm512_rsqrt14_pd(l2);
+          for (unsigned int it = 0; it < 2; ++it)
+            inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_halves));
           const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
-          const __m512d dl = _mm512_sub_pd(l, rb);
+          const __m512d dl = _mm512_sub_pd(_mm512_mul_pd(l2, inv), rb);
           const __mmask8 brk =
             _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
           const __mmask8 live = alive & ~brk;
           const __m512d  scale =
-            _mm512_maskz_div_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), l);
+            _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), inv);
           for (unsigned int d = 0; d < dim; ++d)
             acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
           if (brk)
