@@ -250,7 +250,11 @@ EOF_LMP
       matched++
     }
     END {
-      tol = 1e-8
+      # Round-off bound (doc/benchmarks.md): LAMMPS integrates absolute
+      # positions |x| <= 11, each update rounding by <= 11 * 2^-53 = 1.2e-15;
+      # over 200 steps that is <= 2.5e-13 = 3e-12 max|u|, and the stable
+      # linear dynamics do not amplify it by more than the step count.
+      tol = 1e-10
       printf "lammps_agreement_bonds_lammps: %d\n", lbonds
       printf "lammps_agreement_bonds_perideal: %d\n", pbonds
       printf "lammps_agreement_compared_values: %d\n", 3 * matched
@@ -264,4 +268,5 @@ EOF_LMP
       printf "lammps_agreement_pass: %d\n", ok
     }' "$work/perideal_agreement.txt" "$work/dump.agreement" | tee -a "$results"
 fi
+echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"
 echo "run-all: results in $results" >&2
