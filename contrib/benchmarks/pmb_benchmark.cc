@@ -172,9 +172,9 @@ namespace
     const double vec_bytes = Utilities::MPI::sum(
       5. * dim * double(disc->n_owned() + disc->n_ghost()) * sizeof(double), comm);
 
-    print("nodes", nodes);
-    print("bonds", bonds);
-    print("stencil_size", nb.stencil_size);
+    print_exact("nodes", nodes);
+    print_exact("bonds", bonds);
+    print_exact("stencil_size", nb.stencil_size);
     print("bonds_per_node", bonds / nodes);
     print("regular_row_fraction",
           Utilities::MPI::sum(double(nb.n_regular_rows), comm) / nodes);

@@ -236,8 +236,12 @@ namespace PeriDEAL
                       __m512d            *y)
     {
       const double *rec[8];
-      for (unsigned int q = 0; q < 8; ++q)
-        rec[q] = b + q < n ? p + std::size_t(record_size<dim>) * col[b + q] : pi;
+      if (b + 8 <= n)
+        for (unsigned int q = 0; q < 8; ++q)
+          rec[q] = p + std::size_t(record_size<dim>) * col[b + q];
+      else
+        for (unsigned int q = 0; q < 8; ++q)
+          rec[q] = b + q < n ? p + std::size_t(record_size<dim>) * col[b + q] : pi;
       if constexpr (dim == 2)
         {
           __m512d lo = _mm512_castpd128_pd512(_mm_loadu_pd(rec[0]));
