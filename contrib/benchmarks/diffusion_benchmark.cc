@@ -31,6 +31,8 @@
 #include <perideal/discretization/domain.h>
 #include <perideal/models/diffusion.h>
 
+#include "benchmark_utilities.h"
+
 #ifdef __AVX512F__
 #  include <immintrin.h>
 #endif
@@ -52,6 +54,7 @@
 #include <vector>
 
 using namespace PeriDEAL;
+using namespace PeriDEALBenchmarks;
 
 namespace
 {
@@ -90,74 +93,6 @@ namespace
     if (name == "3d_m12")
       return {name, 3, 12, 19683};
     throw std::runtime_error("unknown case " + name + " (2d_m3, 2d_m12, 3d_m3, 3d_m12)");
-  }
-
-  /** VmRSS and VmHWM of this process in bytes. */
-  std::pair<double, double>
-  rss_bytes()
-  {
-    std::ifstream in("/proc/self/status");
-    std::string   line;
-    double        rss = 0., hwm = 0.;
-    while (std::getline(in, line))
-      {
-        std::istringstream s(line);
-        std::string        key;
-        double             kb;
-        s >> key >> kb;
-        if (key == "VmRSS:")
-          rss = kb * 1024.;
-        else if (key == "VmHWM:")
-          hwm = kb * 1024.;
-      }
-    return {rss, hwm};
-  }
-
-  // -------------------------------------------------------------------
-  double
-  thread_cpu_seconds()
-  {
-    timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-  }
-
-  struct Timing
-  {
-    double wall = 0.; ///< max over ranks of the wall seconds
-    double cpu  = 0.; ///< sum over ranks of the thread CPU seconds
-  };
-
-  /**
-   * Seconds of @p steps calls of @p f, timed in up to ten chunks: the
-   * result is steps x the fastest chunk's time per call (the machine is
-   * shared, the best chunk is the least disturbed one). Wall time with
-   * MPI_Wtime (max over ranks) and, as a cross-check that does not count
-   * time the scheduler gave to other processes, thread CPU time (sum over
-   * ranks).
-   */
-  template <typename F>
-  Timing
-  time_loop(const MPI_Comm comm, const unsigned int steps, F &&f)
-  {
-    const unsigned int chunks = std::min(10u, steps);
-    Timing             best{std::numeric_limits<double>::max(),
-                std::numeric_limits<double>::max()};
-    unsigned int       done = 0;
-    for (unsigned int c = 0; c < chunks; ++c)
-      {
-        const unsigned int n = (steps - done) / (chunks - c);
-        MPI_Barrier(comm);
-        const double t0 = MPI_Wtime(), c0 = thread_cpu_seconds();
-        for (unsigned int s = 0; s < n; ++s)
-          f();
-        const double cpu = Utilities::MPI::sum(thread_cpu_seconds() - c0, comm);
-        const double t   = Utilities::MPI::max(MPI_Wtime() - t0, comm);
-        best.wall        = std::min(best.wall, t / n);
-        best.cpu         = std::min(best.cpu, cpu / n);
-        done += n;
-      }
-    return {best.wall * steps, best.cpu * steps};
   }
 
   struct CaseResult

@@ -6,6 +6,16 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__)
+#  include <immintrin.h>
+#  define PERIDEAL_PMB_AVX512 1
+// GCC 12 reports its own _mm512_undefined_pd() pass-through operands of
+// inlined AVX-512 intrinsics as maybe-uninitialized (a false positive).
+#  if defined(__GNUC__) && !defined(__clang__)
+#    pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#  endif
+#endif
+
 namespace PeriDEAL
 {
   void
@@ -126,17 +136,19 @@ namespace PeriDEAL
     const auto &nb = disc.neighborhood;
     // omega at min(r, delta): bonds of the partial-volume shell beyond delta
     // keep the horizon value, weighted by beta (as in the diffusion model).
+    // Stored divided by |xi|: the bond stiffness ||C(xi)|| beta V_j, which
+    // saves a division per bond in compute_forces().
     bond_coefficient.resize(nb.bond_length.size());
     for (std::size_t t = 0; t < bond_coefficient.size(); ++t)
-      bond_coefficient[t] =
-        c * influence(p.omega, std::min(nb.bond_length[t], delta), delta) * nb.bond_weight[t];
+      bond_coefficient[t] = c * influence(p.omega, std::min(nb.bond_length[t], delta), delta) *
+                            nb.bond_weight[t] / nb.bond_length[t];
 
     row_stiffness.resize(disc.n_owned());
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         double s = 0.;
         for (std::uint64_t k = 0; k < nb.row_start[i + 1] - nb.row_start[i]; ++k)
-          s += bond_coefficient[nb.table_start[i] + k] / nb.bond_length[nb.table_start[i] + k];
+          s += bond_coefficient[nb.table_start[i] + k];
         row_stiffness[i] = s;
       }
     broken_flag.assign(nb.n_bonds(), 0);
@@ -150,17 +162,241 @@ namespace PeriDEAL
       disc.initialize_vector(v);
   }
 
+  namespace
+  {
+    /**
+     * Doubles per node in the deformed-position records of compute_forces():
+     * dim, padded to 4 in 3D so that a record is one aligned 32-byte load.
+     */
+    template <int dim>
+    constexpr unsigned int record_size = dim == 3 ? 4 : dim;
+
+    /**
+     * One row of the nonlinear PMB force, portable version. p holds the
+     * deformed positions x - x_c + u (records of record_size<dim>
+     * doubles), k the bond stiffnesses c omega beta V / |xi| and r the
+     * lengths |xi| of the row's table slice. With l = |y|, y = p_j - p_i,
+     * the force is k (l - r) y / l, i.e. c omega s beta V y / l with the
+     * stretch s = (l - r)/r (3.1); the bond breaks when l - r > s0 r, i.e.
+     * s > s0 (2.34). The two copies of a bond evaluate the same
+     * correctly rounded expressions of y and -y (and the same table
+     * values), so they see the same l and break together.
+     */
+    template <int dim>
+    inline void
+    pmb_row(const double       *p,
+            const double       *pi,
+            const std::int32_t *col,
+            const double       *k,
+            const double       *r,
+            std::uint8_t       *broken,
+            const unsigned int  n,
+            const double        s0,
+            double             *f)
+    {
+      for (unsigned int b = 0; b < n; ++b)
+        {
+          if (broken[b])
+            continue;
+          const double *pj = p + std::size_t(record_size<dim>) * col[b];
+          double        y[dim];
+          for (unsigned int d = 0; d < dim; ++d)
+            y[d] = pj[d] - pi[d];
+          double l2 = y[0] * y[0];
+          for (unsigned int d = 1; d < dim; ++d)
+            l2 = std::fma(y[d], y[d], l2);
+          const double l  = std::sqrt(l2);
+          const double dl = l - r[b];
+          if (dl > s0 * r[b])
+            {
+              broken[b] = 1;
+              continue;
+            }
+          const double scale = k[b] * dl / l;
+          for (unsigned int d = 0; d < dim; ++d)
+            f[d] = std::fma(scale, y[d], f[d]);
+        }
+    }
+
+#ifdef PERIDEAL_PMB_AVX512
+    /**
+     * y_j - p_i for the eight bonds b..b+7 of a row as dim vectors: each
+     * bond loads its neighbour's record (16 B in 2D, 32 B in 3D) and the
+     * records are transposed in registers. This is faster than zmm gathers
+     * on AMD Zen (doc/benchmarks.md). Lanes past the row end read the
+     * row's own record.
+     */
+    template <int dim>
+    inline void
+    load_bond_vectors(const double       *p,
+                      const double       *pi,
+                      const std::int32_t *col,
+                      const unsigned int  b,
+                      const unsigned int  n,
+                      __m512d            *y)
+    {
+      const double *rec[8];
+      if (b + 8 <= n)
+        for (unsigned int q = 0; q < 8; ++q)
+          rec[q] = p + std::size_t(record_size<dim>) * col[b + q];
+      else
+        for (unsigned int q = 0; q < 8; ++q)
+          rec[q] = b + q < n ? p + std::size_t(record_size<dim>) * col[b + q] : pi;
+      if constexpr (dim == 2)
+        {
+          __m512d lo = _mm512_castpd128_pd512(_mm_loadu_pd(rec[0]));
+          __m512d hi = _mm512_castpd128_pd512(_mm_loadu_pd(rec[4]));
+          lo         = _mm512_insertf64x2(lo, _mm_loadu_pd(rec[1]), 1);
+          hi         = _mm512_insertf64x2(hi, _mm_loadu_pd(rec[5]), 1);
+          lo         = _mm512_insertf64x2(lo, _mm_loadu_pd(rec[2]), 2);
+          hi         = _mm512_insertf64x2(hi, _mm_loadu_pd(rec[6]), 2);
+          lo         = _mm512_insertf64x2(lo, _mm_loadu_pd(rec[3]), 3);
+          hi         = _mm512_insertf64x2(hi, _mm_loadu_pd(rec[7]), 3);
+          y[0] = _mm512_permutex2var_pd(lo, _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14), hi);
+          y[1] = _mm512_permutex2var_pd(lo, _mm512_setr_epi64(1, 3, 5, 7, 9, 11, 13, 15), hi);
+        }
+      else
+        {
+          __m512d v[4];
+          for (unsigned int q = 0; q < 4; ++q)
+            v[q] = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_loadu_pd(rec[2 * q])),
+                                      _mm256_loadu_pd(rec[2 * q + 1]), 1);
+          const __m512i ixy = _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13);
+          const __m512i iz  = _mm512_setr_epi64(2, 6, 10, 14, 2, 6, 10, 14);
+          const __m512d xy0 = _mm512_permutex2var_pd(v[0], ixy, v[1]);
+          const __m512d xy1 = _mm512_permutex2var_pd(v[2], ixy, v[3]);
+          const __m512d z0  = _mm512_permutex2var_pd(v[0], iz, v[1]);
+          const __m512d z1  = _mm512_permutex2var_pd(v[2], iz, v[3]);
+          y[0]              = _mm512_shuffle_f64x2(xy0, xy1, 0x44);
+          y[1]              = _mm512_shuffle_f64x2(xy0, xy1, 0xEE);
+          y[2]              = _mm512_shuffle_f64x2(z0, z1, 0x44);
+        }
+      for (unsigned int d = 0; d < dim; ++d)
+        y[d] = _mm512_sub_pd(y[d], _mm512_set1_pd(pi[d]));
+    }
+
+    /**
+     * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
+     * one accumulator per component reduced once per row. Every bond goes
+     * through the same instructions (1/l from vrsqrt14pd and Newton steps,
+     * a few ulp from 1/sqrt), so the two copies of a bond still see
+     * bitwise the same l and break together.
+     */
+    template <int dim>
+    inline void
+    pmb_row_avx512(const double       *p,
+                   const double       *pi,
+                   const std::int32_t *col,
+                   const double       *k,
+                   const double       *r,
+                   std::uint8_t       *broken,
+                   const unsigned int  n,
+                   const double        s0,
+                   double             *f)
+    {
+      __m512d acc[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        acc[d] = _mm512_setzero_pd();
+      const __m512d vs0 = _mm512_set1_pd(s0), half = _mm512_set1_pd(0.5),
+                    three_halves = _mm512_set1_pd(1.5);
+      for (unsigned int b = 0; b < n; b += 8)
+        {
+          const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
+          const __mmask8 alive =
+            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, broken + b), _mm_setzero_si128());
+          if (alive == 0)
+            continue;
+          __m512d y[dim];
+          load_bond_vectors<dim>(p, pi, col, b, n, y);
+          __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+          for (unsigned int d = 1; d < dim; ++d)
+            l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+          // 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton steps
+          // inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is the
+          // bottleneck of sqrt + div (doc/benchmarks.md). Masked-off and
+          // broken lanes get l2 = 1 to keep inv finite.
+          l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
+          const __m512d h = _mm512_mul_pd(half, l2);
+          __m512d       inv = _mm512_rsqrt14_pd(l2);
+          for (unsigned int it = 0; it < 2; ++it)
+            inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_halves));
+          const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
+          const __m512d dl = _mm512_sub_pd(_mm512_mul_pd(l2, inv), rb);
+          const __mmask8 brk =
+            _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
+          const __mmask8 live = alive & ~brk;
+          const __m512d  scale =
+            _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), inv);
+          for (unsigned int d = 0; d < dim; ++d)
+            acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
+          if (brk)
+            _mm_mask_storeu_epi8(broken + b, brk, _mm_set1_epi8(1));
+        }
+      for (unsigned int d = 0; d < dim; ++d)
+        f[d] = _mm512_reduce_add_pd(acc[d]);
+    }
+#endif
+  } // namespace
+
   template <int dim>
   void
   BondBasedOperator<dim>::compute_forces(const VectorField &u, VectorField &force)
   {
-    const auto                   &nb  = disc.neighborhood;
-    const std::vector<Point<dim>> &x   = disc.position;
+    const auto                    &nb = disc.neighborhood;
+    const std::vector<Point<dim>> &x  = disc.position;
+    const unsigned int             n_owned = disc.n_owned();
+
+    if (!linearized)
+      {
+        // Deformed positions x - x_c + u of all local nodes, interleaved,
+        // so that a bond loads one contiguous record. x_c is the lattice
+        // centre (the same on every rank): |x - x_c| is at most half the
+        // body, which bounds the round-off of y = p_j - p_i by
+        // eps |x - x_c|.
+        const std::size_t  n_local = x.size();
+        constexpr unsigned int R   = record_size<dim>;
+        deformed.resize(n_local * R);
+        std::array<int, dim> mid;
+        for (unsigned int d = 0; d < dim; ++d)
+          mid[d] = int(disc.lattice_size()[d] / 2);
+        const Point<dim> xc = disc.lattice_point(mid);
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double *ud = u[d].begin();
+            for (std::size_t i = 0; i < n_local; ++i)
+              deformed[R * i + d] = (x[i][d] - xc[d]) + ud[i];
+          }
+        const double *p = deformed.data();
+        for (unsigned int i = 0; i < n_owned; ++i)
+          {
+            const std::uint64_t begin = nb.row_start[i];
+            const unsigned int  n     = nb.row_start[i + 1] - begin;
+            double              f[dim] = {};
+#ifdef PERIDEAL_PMB_AVX512
+            if constexpr (dim > 1)
+              pmb_row_avx512<dim>(p, p + std::size_t(record_size<dim>) * i, nb.col.data() + begin,
+                                  bond_coefficient.data() + nb.table_start[i],
+                                  nb.bond_length.data() + nb.table_start[i],
+                                  broken_flag.data() + begin, n, s0, f);
+            else
+#endif
+              pmb_row<dim>(p, p + std::size_t(record_size<dim>) * i, nb.col.data() + begin,
+                           bond_coefficient.data() + nb.table_start[i],
+                           nb.bond_length.data() + nb.table_start[i], broken_flag.data() + begin,
+                           n, s0, f);
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(i) = f[d];
+          }
+        return;
+      }
+
+    // Linearized bond force (2.32): C(xi) eta = c omega beta V (xi.eta /
+    // |xi|^3) xi, with xi and eta from positions so that the copy of the
+    // bond in row j sees exactly -xi, -eta and hence the same stretch.
     std::array<const double *, dim> ud;
     for (unsigned int d = 0; d < dim; ++d)
       ud[d] = u[d].begin();
-
-    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+    for (unsigned int i = 0; i < n_owned; ++i)
       {
         const std::uint64_t begin = nb.row_start[i];
         const double       *coef  = bond_coefficient.data() + nb.table_start[i];
@@ -170,41 +406,24 @@ namespace PeriDEAL
             if (broken_flag[b])
               continue;
             const std::int32_t j = nb.col[b];
-            // xi and eta from positions so that the copy of the bond in row
-            // j sees exactly -xi, -eta and hence the bitwise same stretch.
-            double xi[dim], y[dim], r2 = 0., l2 = 0., xe = 0.;
+            double             xi[dim], r2 = 0., xe = 0.;
             for (unsigned int d = 0; d < dim; ++d)
               {
                 xi[d]            = x[j][d] - x[i][d];
                 const double eta = ud[d][j] - ud[d][i];
-                y[d]             = xi[d] + eta;
                 r2 += xi[d] * xi[d];
-                l2 += y[d] * y[d];
                 xe += xi[d] * eta;
               }
-            const double r = std::sqrt(r2);
-            double       s, scale;
-            const double *dir;
-            if (linearized)
-              {
-                s     = xe / r2;
-                scale = coef[b - begin] * s / r;
-                dir   = xi;
-              }
-            else
-              {
-                const double l = std::sqrt(l2);
-                s              = (l - r) / r;
-                scale          = coef[b - begin] * s / l;
-                dir            = y;
-              }
+            const double s = xe / r2;
             if (s > s0)
               {
                 broken_flag[b] = 1;
                 continue;
               }
+            // coef = c omega beta V / |xi|, so the force is coef s xi.
+            const double scale = coef[b - begin] * s;
             for (unsigned int d = 0; d < dim; ++d)
-              f[d] += scale * dir[d];
+              f[d] += scale * xi[d];
           }
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
@@ -238,7 +457,7 @@ namespace PeriDEAL
               }
             const double r = std::sqrt(r2);
             const double s = linearized ? xe / r2 : (std::sqrt(l2) - r) / r;
-            w += coef[b - begin] * s * s * r;
+            w += coef[b - begin] * s * s * r2;
           }
         W.local_element(i) = 0.25 * w;
       }

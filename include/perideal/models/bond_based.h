@@ -211,10 +211,12 @@ namespace PeriDEAL
     const Discretization<dim> &disc;
     double                     c, s0;
     bool                       linearized;
-    /** c omega(min(|xi|, delta)) beta V_j per table entry. */
+    /** c omega(min(|xi|, delta)) beta V_j / |xi| per table entry. */
     std::vector<double> bond_coefficient;
     std::vector<double> row_stiffness;
     std::vector<std::uint8_t> broken_flag;
+    /** Scratch of compute_forces(): deformed positions of the local nodes. */
+    std::vector<double> deformed;
   };
 } // namespace PeriDEAL
 

@@ -1,0 +1,407 @@
+// ---------------------------------------------------------------------
+// PeriDEAL benchmark: nonlinear bond-based PD (PMB) with fracture,
+// BondBasedOperator<dim>::compute_forces inside VelocityVerlet<dim>::advance,
+// on uniform lattices; and the small elastic case that
+// contrib/benchmarks/run-all.sh compares with LAMMPS `pair_style peri/pmb`.
+//
+// Lattice: n nodes per direction on [0, n-1]^dim, dx = 1 (LAMMPS `lattice
+// sc 1.0`), delta = m dx, partial volumes, constant influence, E = 1,
+// rho = 1, c = bond_based_micromodulus (3D: 18K/(pi delta^4), LAMMPS's
+// convention), dt = 0.5 x the critical step (3.8). Fracture case: the two
+// halves x < (n-1)/2 and x > (n-1)/2 start with velocities -v0 e_x and
+// +v0 e_x, v0 = 4 s0 (the speed of sound is about 1): the bonds crossing
+// the mid plane break within a few steps, the halves then fly apart (a
+// bounded number of broken bonds however long the run).
+//
+// Usage: pmb_benchmark [options]
+//   --case NAME      2d_m3 | 2d_m12 | 2d_m24 | 3d_m3 | 3d_m12 (repeatable)
+//   --dim D --m M --nodes N   a custom case
+//   --steps S        timed steps (0: enough for --seconds)
+//   --seconds T      target wall time of the timed loop (default 1)
+//   --profile-steps S  only run S Verlet steps after setup (for profilers)
+//   --agreement FILE the LAMMPS agreement case: 12^3 nodes, m = 3, LAMMPS's
+//                    bond family (|xi| <= delta), no breaking; writes
+//                    "step i j k ux uy uz" lines every --every steps to FILE
+//   --agreement-steps S (default 200), --every E (default 20)
+// Prints `key: value` lines (keys in doc/benchmarks.md).
+// ---------------------------------------------------------------------
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <perideal/discretization/discretization.h>
+#include <perideal/discretization/domain.h>
+#include <perideal/models/bond_based.h>
+#include <perideal/time_stepping/velocity_verlet.h>
+
+#include "benchmark_utilities.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace PeriDEAL;
+using namespace PeriDEALBenchmarks;
+
+namespace
+{
+  struct Case
+  {
+    std::string  name; // key prefix after "pmb_"
+    unsigned int dim   = 2;
+    unsigned int m     = 3;
+    double       nodes = 1e6;
+  };
+
+  struct Options
+  {
+    std::vector<Case> cases;
+    unsigned int      steps         = 0;
+    double            seconds       = 1.;
+    unsigned int      profile_steps = 0;
+    std::string       agreement_file;
+    unsigned int      agreement_steps = 200;
+    unsigned int      every           = 20;
+  };
+
+  Case
+  preset(const std::string &name)
+  {
+    // 2D m = 24: 1889 bonds per node, so 500^2 nodes (4.7e8 bonds) to keep
+    // the memory near that of 2D m = 12. 3D m = 3 is the LAMMPS comparison
+    // problem: 40^3 nodes (an even count: no node on the mid plane), small
+    // enough for LAMMPS to run the same steps in seconds. 3D m = 12: as
+    // in the diffusion benchmark, 27^3 nodes (a cube must be wider than 25
+    // nodes to have interior rows). 3D m = 24 does not fit: an interior
+    // row needs a cube wider than 49 nodes, i.e. >= 50^3 x 6e4 = 7.5e9
+    // bonds, 37 GB for column indices and broken flags alone (23 GB RAM).
+    if (name == "2d_m3")
+      return {name, 2, 3, 1e6};
+    if (name == "2d_m12")
+      return {name, 2, 12, 1e6};
+    if (name == "2d_m24")
+      return {name, 2, 24, 2.5e5};
+    if (name == "3d_m3")
+      return {name, 3, 3, 64000};
+    if (name == "3d_m12")
+      return {name, 3, 12, 19683};
+    throw std::runtime_error("unknown case " + name +
+                             " (2d_m3, 2d_m12, 2d_m24, 3d_m3, 3d_m12)");
+  }
+
+  template <int dim>
+  std::unique_ptr<Discretization<dim>>
+  make_lattice(const MPI_Comm comm, const unsigned int n_side, const unsigned int m)
+  {
+    LatticeParameters lp;
+    lp.dx              = 1.;
+    lp.delta           = m;
+    lp.partial_volume  = true;
+    lp.cell_centered   = false;
+    lp.layer_thickness = 0.;
+    Point<dim> upper;
+    for (unsigned int d = 0; d < dim; ++d)
+      upper[d] = n_side - 1.;
+    auto disc = std::make_unique<Discretization<dim>>(comm);
+    disc->setup(BoxDomain<dim>(Point<dim>(), upper), lp);
+    return disc;
+  }
+
+  template <int dim>
+  void
+  run_case(const Case &c, const Options &opt, const MPI_Comm comm)
+  {
+    const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
+    const unsigned int n_ranks = Utilities::MPI::n_mpi_processes(comm);
+    const std::string  prefix  = "pmb_" + c.name + "_";
+    auto               print   = [&](const std::string &key, const double value) {
+      if (rank == 0)
+        std::printf("%s%s: %.6g\n", prefix.c_str(), key.c_str(), value);
+    };
+    auto print_exact = [&](const std::string &key, const double value) {
+      if (rank == 0)
+        std::printf("%s%s: %.17g\n", prefix.c_str(), key.c_str(), value);
+    };
+    auto flush = [&] {
+      if (rank == 0)
+        std::fflush(stdout);
+    };
+
+    const unsigned int n_side = std::max(2., std::round(std::pow(c.nodes, 1. / dim)));
+    const double       rss_before = rss_bytes().first;
+    MPI_Barrier(comm);
+    const double t0   = MPI_Wtime();
+    auto         disc = make_lattice<dim>(comm, n_side, c.m);
+
+    BondBasedModelParameters mp;
+    mp.youngs_modulus = 1.;
+    mp.plane_stress   = true;
+    mp.linearized     = false;
+    mp.critical_stretch = 1e-3;
+    BondBasedOperator<dim> model(*disc, mp);
+    const double           rho = 1.;
+    const double           dt  = 0.5 * model.critical_time_step(rho);
+    VelocityVerlet<dim>    verlet(model, rho, dt);
+    const double           t_setup = Utilities::MPI::max(MPI_Wtime() - t0, comm);
+
+    // Two halves pulled apart (see the header).
+    const double v0 = 4. * model.critical_stretch();
+    const double xc = 0.5 * (n_side - 1.);
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      verlet.velocity[0].local_element(i) = disc->position[i][0] > xc ? v0 : -v0;
+    verlet.initialize();
+
+    const auto   rss_after = rss_bytes();
+    const auto  &nb        = disc->neighborhood;
+    const double bonds     = double(disc->n_global_bonds());
+    const double nodes     = double(disc->n_global());
+
+    // Memory: CSR; the operator's coefficient per table entry, stiffness
+    // per row and broken flag per bond; the Verlet fields (u, v, a, b and
+    // the force: 5 dim vectors with ghosts).
+    const double nb_bytes = Utilities::MPI::sum(double(nb.memory_consumption()), comm);
+    const double op_bytes = Utilities::MPI::sum(
+      double(nb.bond_length.size() * sizeof(double) + disc->n_owned() * sizeof(double) +
+             nb.n_bonds() * sizeof(std::uint8_t)),
+      comm);
+    const double vec_bytes = Utilities::MPI::sum(
+      5. * dim * double(disc->n_owned() + disc->n_ghost()) * sizeof(double), comm);
+
+    print_exact("nodes", nodes);
+    print_exact("bonds", bonds);
+    print_exact("stencil_size", nb.stencil_size);
+    print("bonds_per_node", bonds / nodes);
+    print("regular_row_fraction",
+          Utilities::MPI::sum(double(nb.n_regular_rows), comm) / nodes);
+    print("setup_seconds", t_setup);
+    print("neighborhood_bytes_per_bond", nb_bytes / bonds);
+    print("operator_bytes_per_bond", op_bytes / bonds);
+    print("vector_bytes_per_bond", vec_bytes / bonds);
+    print("bytes_per_bond", (nb_bytes + op_bytes + vec_bytes) / bonds);
+    print("rss_bytes_per_bond",
+          Utilities::MPI::sum(rss_after.first - rss_before, comm) / bonds);
+    print("peak_rss_bytes_per_bond", Utilities::MPI::sum(rss_after.second, comm) / bonds);
+    // Parameters a second code needs to run the same problem.
+    print_exact("n_side", n_side);
+    print_exact("delta", disc->parameters().delta);
+    print_exact("micromodulus", model.micromodulus());
+    print_exact("critical_stretch", model.critical_stretch());
+    print_exact("density", rho);
+    print_exact("dt", dt);
+    print_exact("v0", v0);
+    flush();
+
+    if (opt.profile_steps > 0)
+      {
+        for (unsigned int s = 0; s < opt.profile_steps; ++s)
+          verlet.advance();
+        return;
+      }
+
+    // Warm-up step, which also calibrates the number of steps.
+    const double t_one = time_loop(comm, 1, [&] { verlet.advance(); }).wall;
+    unsigned int steps = opt.steps;
+    if (steps == 0)
+      steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
+    steps = Utilities::MPI::max(steps, comm);
+    print("steps", steps);
+
+    const double bond_updates = bonds * steps;
+    const Timing t_step       = time_loop(comm, steps, [&] { verlet.advance(); });
+    print("step_seconds", t_step.wall / steps);
+    print("bond_updates_per_s_per_core", bond_updates / (t_step.wall * n_ranks));
+    print("bond_updates_per_cpu_second", bond_updates / t_step.cpu);
+    print("loop_seconds", t_step.total);
+    print("loop_bond_updates_per_s_per_core", bond_updates / (t_step.total * n_ranks));
+    print("loop_cpu_seconds", t_step.total_cpu);
+    print("loop_bond_updates_per_cpu_second", bond_updates / t_step.total_cpu);
+    print("broken_bond_fraction", double(model.n_broken_bonds()) / bonds);
+    flush();
+
+    // compute_forces alone (the state keeps evolving between the chunks
+    // of the loop above; here u is frozen).
+    typename BondBasedOperator<dim>::VectorField force;
+    model.initialize(force);
+    const Timing t_force =
+      time_loop(comm, steps, [&] { model.compute_forces(verlet.displacement, force); });
+    print("force_seconds", t_force.wall / steps);
+    print("force_bond_updates_per_s_per_core", bond_updates / (t_force.wall * n_ranks));
+    flush();
+  }
+
+  // The LAMMPS agreement case: see the header and doc/benchmarks.md.
+  void
+  run_agreement(const Options &opt, const MPI_Comm comm)
+  {
+    constexpr int      dim    = 3;
+    const unsigned int n_side = 12, m = 3;
+    auto               disc   = make_lattice<dim>(comm, n_side, m);
+    const double       delta = m;
+    // LAMMPS's family is |xi| <= delta (fix peri/neigh) with vfrac scaled
+    // by (delta + dx/2 - |xi|)/dx for |xi| >= delta - dx/2: PeriDEAL's beta
+    // without the shell delta < |xi| < delta + dx/2, whose weights are set
+    // to zero here. Integer lattice coordinates make |xi|^2 exact, so both
+    // codes classify the bonds at |xi| = delta alike.
+    auto &nb = disc->neighborhood;
+    for (std::size_t t = 0; t < nb.bond_length.size(); ++t)
+      if (nb.bond_length[t] > delta)
+        nb.bond_weight[t] = 0.;
+
+    BondBasedModelParameters mp;
+    mp.youngs_modulus = 1.;
+    mp.linearized     = false;
+    BondBasedOperator<dim> model(*disc, mp);
+    const double           rho = 1., dt = 0.5 * model.critical_time_step(rho);
+    VelocityVerlet<dim>    verlet(model, rho, dt);
+    const double           A = 1e-3, L = n_side - 1.;
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      {
+        const Point<dim> &p = disc->position[i];
+        verlet.velocity[0].local_element(i) = A * std::sin(M_PI * p[0] / L) * std::cos(M_PI * p[1] / L);
+        verlet.velocity[1].local_element(i) = A * std::cos(M_PI * p[2] / L);
+        verlet.velocity[2].local_element(i) = A * std::sin(M_PI * p[1] / L) * std::sin(M_PI * p[0] / L);
+      }
+    verlet.initialize();
+
+    AssertThrow(Utilities::MPI::n_mpi_processes(comm) == 1,
+                ExcMessage("--agreement runs on one rank"));
+    FILE *out = std::fopen(opt.agreement_file.c_str(), "w");
+    AssertThrow(out != nullptr, ExcMessage("cannot write " + opt.agreement_file));
+    double max_u = 0., min_stretch = 0.;
+    auto   write = [&] {
+      for (unsigned int i = 0; i < disc->n_owned(); ++i)
+        {
+          const auto &li = disc->lattice_index[i];
+          std::fprintf(out, "%u %d %d %d", verlet.step(), li[0], li[1], li[2]);
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double u = verlet.displacement[d].local_element(i);
+              max_u          = std::max(max_u, std::abs(u));
+              std::fprintf(out, " %.17g", u);
+            }
+          std::fprintf(out, "\n");
+        }
+    };
+    // The smallest bond stretch seen: LAMMPS's contact force acts only on
+    // pairs compressed below 0.9 |xi| (stretch < -0.1).
+    auto track_stretch = [&] {
+      for (unsigned int i = 0; i < disc->n_owned(); ++i)
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          {
+            const int j = nb.col[b];
+            double    r2 = 0., l2 = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double xi = disc->position[j][d] - disc->position[i][d];
+                const double y  = xi + verlet.displacement[d].local_element(j) -
+                                 verlet.displacement[d].local_element(i);
+                r2 += xi * xi;
+                l2 += y * y;
+              }
+            min_stretch = std::min(min_stretch, std::sqrt(l2 / r2) - 1.);
+          }
+    };
+    // Bonds that carry a force (the zeroed shell excluded): LAMMPS's count.
+    double n_weighted = 0.;
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+        n_weighted += nb.bond_weight[nb.table_start[i] + b - nb.row_start[i]] > 0.;
+    write();
+    for (unsigned int s = 1; s <= opt.agreement_steps; ++s)
+      {
+        verlet.advance();
+        track_stretch();
+        if (s % opt.every == 0)
+          write();
+      }
+    std::fclose(out);
+    std::printf("agreement_n_side: %u\nagreement_delta: %.17g\nagreement_micromodulus: %.17g\n"
+                "agreement_dt: %.17g\nagreement_amplitude: %.17g\nagreement_steps: %u\n"
+                "agreement_every: %u\nagreement_bonds_with_weight: %.0f\n"
+                "agreement_max_displacement: %.6g\nagreement_min_stretch: %.6g\n",
+                n_side, delta, model.micromodulus(), dt, A, opt.agreement_steps, opt.every,
+                n_weighted, max_u, min_stretch);
+    std::fflush(stdout);
+  }
+
+  Options
+  parse(int argc, char **argv)
+  {
+    Options opt;
+    Case    custom;
+    bool    have_custom = false;
+    for (int a = 1; a < argc; ++a)
+      {
+        const std::string arg  = argv[a];
+        auto              next = [&]() -> std::string {
+          if (a + 1 >= argc)
+            throw std::runtime_error("missing value after " + arg);
+          return argv[++a];
+        };
+        if (arg == "--case")
+          opt.cases.push_back(preset(next()));
+        else if (arg == "--dim")
+          custom.dim = std::stoi(next()), have_custom = true;
+        else if (arg == "--m")
+          custom.m = std::stoi(next()), have_custom = true;
+        else if (arg == "--nodes")
+          custom.nodes = std::stod(next()), have_custom = true;
+        else if (arg == "--steps")
+          opt.steps = std::stoi(next());
+        else if (arg == "--seconds")
+          opt.seconds = std::stod(next());
+        else if (arg == "--profile-steps")
+          opt.profile_steps = std::stoi(next());
+        else if (arg == "--agreement")
+          opt.agreement_file = next();
+        else if (arg == "--agreement-steps")
+          opt.agreement_steps = std::stoi(next());
+        else if (arg == "--every")
+          opt.every = std::max(1, std::stoi(next()));
+        else if (arg == "--help" || arg == "-h")
+          {
+            std::printf("see the header of contrib/benchmarks/pmb_benchmark.cc\n");
+            std::exit(0);
+          }
+        else
+          throw std::runtime_error("unknown argument " + arg);
+      }
+    if (have_custom)
+      {
+        if (custom.dim < 2 || custom.dim > 3)
+          throw std::runtime_error("--dim must be 2 or 3");
+        custom.name = std::to_string(custom.dim) + "d_m" + std::to_string(custom.m);
+        opt.cases.push_back(custom);
+      }
+    if (opt.cases.empty() && opt.agreement_file.empty())
+      for (const char *name : {"2d_m3", "2d_m12", "2d_m24", "3d_m3", "3d_m12"})
+        opt.cases.push_back(preset(name));
+    return opt;
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const MPI_Comm                   comm = MPI_COMM_WORLD;
+  try
+    {
+      const Options opt = parse(argc, argv);
+      if (!opt.agreement_file.empty())
+        run_agreement(opt, comm);
+      for (const Case &c : opt.cases)
+        c.dim == 2 ? run_case<2>(c, opt, comm) : run_case<3>(c, opt, comm);
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "pmb_benchmark: " << e.what() << std::endl;
+      MPI_Abort(comm, 1);
+    }
+  return 0;
+}
