@@ -551,7 +551,7 @@ namespace
       check(op.n_broken_bonds() == disc.n_global_bonds(),
             "stretch 1.01 s0: all " + std::to_string(disc.n_global_bonds()) + " bonds break");
       check(std::max(f[0].linfty_norm(), f[1].linfty_norm()) == 0., "force 0 without bonds");
-      Vector phi;
+      PeriDEAL::Vector phi;
       disc.initialize_vector(phi);
       op.damage(phi);
       check(phi.linfty_norm() == 1. && phi.mean_value() == 1., "damage 1 everywhere");
@@ -577,7 +577,7 @@ namespace
             std::to_string(cut.n_broken_bonds()) + " bonds crossing x = xc");
     const double fmax = std::max(f[0].linfty_norm(), f[1].linfty_norm());
     check(fmax == 0., "after breaking the two rigid halves exert no force: max|f| = " + sci(fmax));
-    Vector phi, phi_cut;
+    PeriDEAL::Vector phi, phi_cut;
     disc.initialize_vector(phi);
     disc.initialize_vector(phi_cut);
     op.damage(phi);
