@@ -358,12 +358,13 @@ namespace PeriDEAL
     const double  energy   = strain_energy();
     const auto    reaction = reaction_force();
     const auto    body     = total_body_force();
+    const auto    n_bonds  = disc.n_global_bonds();
     if (Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
       {
         std::ofstream out(prm.output_directory + "/summary.txt");
         out << std::setprecision(12);
         out << "model: " << prm.model << "\ndimension: " << dim
-            << "\nnodes: " << disc.n_global() << "\nbonds: " << disc.n_global_bonds()
+            << "\nnodes: " << disc.n_global() << "\nbonds: " << n_bonds
             << "\nsolver: " << prm.solver << "\niterations: " << iterations
             << "\nrelative_residual: " << residual << "\nsolve_seconds: " << solve_seconds
             << "\nstrain_energy: " << energy;

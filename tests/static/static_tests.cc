@@ -287,6 +287,11 @@ namespace
     return max_error(s, exact);
   }
 
+  // The m-error of the partial-volume scheme is not monotone (the quadrature
+  // of the second moments depends on how the lattice meets the horizon
+  // sphere; e.g. 2D bond-based 2.6e-3 at m = 4, 2.7e-3 at m = 5, 1.2e-3 at
+  // m = 6, 4.2e-5 at m = 8, 6.9e-4 at m = 10: `static_tests scan`), so the
+  // observed order is the least-squares slope of log e over log m.
   template <int dim>
   void
   m_convergence(const std::string &model, const std::vector<unsigned int> &ms,
@@ -294,6 +299,7 @@ namespace
   {
     const double        delta = 0.25;
     std::vector<double> e;
+    double              sx = 0., sy = 0., sxx = 0., sxy = 0.;
     for (const unsigned int m : ms)
       {
         unsigned int n;
@@ -301,23 +307,43 @@ namespace
         if (root())
           std::cout << "  " << model << " " << dim << "D delta = " << delta << " m = " << m
                     << " nodes " << n << ": max rel. error " << sci(e.back()) << std::endl;
+        const double x = std::log(double(m)), y = std::log(e.back());
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
       }
-    for (unsigned int k = 1; k < ms.size(); ++k)
-      {
-        const double order = std::log(e[k - 1] / e[k]) / std::log(double(ms[k]) / ms[k - 1]);
-        check(order > min_order, model + " " + std::to_string(dim) + "D m " +
-                                   std::to_string(ms[k - 1]) + " -> " + std::to_string(ms[k]) +
-                                   ": observed order " + sci(order) + " > " + sci(min_order));
-      }
+    const double n     = ms.size();
+    const double order = -(n * sxy - sx * sy) / (n * sxx - sx * sx);
+    check(order > min_order, model + " " + std::to_string(dim) + "D m = " +
+                               std::to_string(ms.front()) + " .. " + std::to_string(ms.back()) +
+                               ": least-squares order " + sci(order) + " > " + sci(min_order));
+    check(e.back() < e.front(), "error at m = " + std::to_string(ms.back()) + " below that at m = " +
+                                  std::to_string(ms.front()));
+  }
+
+  // Not a ctest: the error table behind the thresholds of test_manufactured.
+  void
+  scan()
+  {
+    for (const std::string model : {"linearized bond-based", "LPS"})
+      for (unsigned int m = 2; m <= 10; ++m)
+        {
+          unsigned int n;
+          const double e = quadratic_error<2>(model, 0.25, m, model == "LPS" ? 2. : 1., &n);
+          if (root())
+            std::cout << "  " << model << " 2D m = " << m << " nodes " << n << ": " << sci(e)
+                      << std::endl;
+        }
   }
 
   void
   test_manufactured()
   {
-    // Thresholds: the measured orders (printed) minus a margin; the m-error of
-    // the partial-volume scheme is not monotone at every step, hence > 1.
-    m_convergence<2>("linearized bond-based", {2, 4, 8}, 1., 1.);
-    m_convergence<2>("LPS", {2, 4, 6}, 2., 1.);
+    // Measured least-squares orders 2.4 (bond-based) and 2.4 (LPS) in 2D,
+    // 1.9 from two points in 3D; asserted with a margin for the scatter.
+    m_convergence<2>("linearized bond-based", {2, 3, 4, 5, 6}, 1., 1.5);
+    m_convergence<2>("LPS", {2, 3, 4, 5, 6}, 2., 1.5);
     m_convergence<3>("linearized bond-based", {2, 3}, 1., 1.);
   }
 
@@ -422,6 +448,13 @@ namespace
     check(yb.linfty_norm() < 1e-13 * scale,
           "1D: linearized bond-based stiffness = step-3's J_1 matrix (max diff " +
             sci(yb.linfty_norm() / scale) + " relative)");
+
+    // The Gershgorin step of the unconstrained 1D matrix is (3.8): the row
+    // sum is 2 sum_j c omega beta V_j / |xi|.
+    TrilinosWrappers::SparseMatrix Kfull;
+    Stiffness::assemble(bb, Kfull);
+    check_close(Stiffness::critical_time_step(Kfull, 2.5), bb.critical_time_step(2.5), 1e-13,
+                "1D: Gershgorin step of K = (3.8)");
   }
 
   // ------------------------------------------------------------ equilibrium
@@ -560,5 +593,6 @@ main(int argc, char **argv)
               {"equilibrium", test_equilibrium},
               {"rank", test_rank},
               {"trig", test_trig},
-              {"step3_1d", test_step3_1d}});
+              {"step3_1d", test_step3_1d},
+              {"scan", scan}});
 }
