@@ -15,6 +15,7 @@
 #include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
 #include <perideal/time_stepping/mechanics_solver.h>
+#include <perideal/time_stepping/static_mechanics.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -48,13 +49,15 @@ namespace
   {
     prm.declare_entry("Dimension", "2", Patterns::Integer(1, 3),
                       "Spatial dimension of the run (1, 2 or 3).");
-    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics"),
+    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics|static mechanics"),
                       "diffusion: PD diffusion and bi-material corrosion (Model/Type); "
                       "mechanics: dynamic bond-based PD with brittle fracture "
-                      "(Model/Bond-based, Mechanics).");
+                      "(Model/Bond-based, Mechanics); static mechanics: static equilibrium "
+                      "of linearized bond-based PD or LPS (Static mechanics).");
     // The entries do not depend on the dimension; declare them once.
     DiffusionRunParameters<2>::declare_parameters(prm);
     MechanicsRunParameters<2>::declare_parameters(prm);
+    StaticMechanicsParameters<2>::declare_parameters(prm);
   }
 
   // A PNG of the time series.
@@ -125,6 +128,12 @@ namespace
   void
   run(ParameterHandler &prm, const bool resume, const unsigned int stop_after)
   {
+    if (prm.get("Problem") == "static mechanics")
+      {
+        write_used_parameters(prm, prm.get({"Output"}, "Directory"));
+        run_static_mechanics<dim>(prm, MPI_COMM_WORLD);
+        return;
+      }
     if (prm.get("Problem") == "mechanics")
       {
         check_parameter(!resume, "command line", "--resume",

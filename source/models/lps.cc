@@ -4,6 +4,7 @@
 #include <perideal/models/lps.h>
 
 #include <cmath>
+#include <limits>
 
 namespace PeriDEAL
 {
@@ -14,6 +15,9 @@ namespace PeriDEAL
                       "omega_0 = 1 (2.12) or omega_1 = 1 - r/delta (2.13).");
     prm.declare_entry("Bulk modulus", "1", Patterns::Double(), "K (> 0).");
     prm.declare_entry("Shear modulus", "1", Patterns::Double(), "G (> 0).");
+    prm.declare_entry("Critical stretch", "0", Patterns::Double(),
+                      "s0 (>= 0) of the bond-breaking criterion on the linearized "
+                      "stretch; 0: bonds never break.");
   }
 
   void
@@ -24,6 +28,9 @@ namespace PeriDEAL
     shear_modulus = prm.get_double("Shear modulus");
     check_parameter(bulk_modulus > 0., "Model/Bulk modulus", bulk_modulus, "a positive number");
     check_parameter(shear_modulus > 0., "Model/Shear modulus", shear_modulus, "a positive number");
+    critical_stretch = prm.get_double("Critical stretch");
+    check_parameter(critical_stretch >= 0., "Model/Critical stretch", critical_stretch,
+                    "a non-negative number (0: no bond breaking)");
   }
 
   template <int dim>
@@ -32,7 +39,13 @@ namespace PeriDEAL
     : disc(discretization)
     , K_d(dim == 3 ? p.bulk_modulus : p.bulk_modulus + p.shear_modulus / 3.)
     , G(p.shear_modulus)
+    , s0(p.critical_stretch > 0. ? p.critical_stretch : std::numeric_limits<double>::infinity())
   {
+    check_parameter(p.bulk_modulus > 0., "Model/Bulk modulus", p.bulk_modulus, "a positive number");
+    check_parameter(p.shear_modulus > 0., "Model/Shear modulus", p.shear_modulus,
+                    "a positive number");
+    check_parameter(p.critical_stretch >= 0., "Model/Critical stretch", p.critical_stretch,
+                    "a non-negative number (0: no bond breaking)");
     const auto  &nb    = disc.neighborhood;
     const double delta = disc.parameters().delta;
     // omega at min(r, delta): bonds of the partial-volume shell beyond delta
@@ -54,6 +67,7 @@ namespace PeriDEAL
         m.local_element(i) = s;
       }
     m.update_ghost_values();
+    broken_flag.assign(nb.n_bonds(), 0);
   }
 
   template <int dim>
@@ -80,6 +94,8 @@ namespace PeriDEAL
         double              s     = 0.;
         for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
           {
+            if (broken_flag[b])
+              continue;
             const std::int32_t j  = nb.col[b];
             double             xe = 0.;
             for (unsigned int d = 0; d < dim; ++d)
@@ -95,6 +111,8 @@ namespace PeriDEAL
   void
   LinearizedLPSOperator<dim>::compute_forces(const VectorField &u, VectorField &force)
   {
+    if (std::isfinite(s0))
+      break_bonds(u);
     compute_dilatation(u, theta);
     theta.update_ghost_values();
 
@@ -118,6 +136,8 @@ namespace PeriDEAL
         double              f[dim] = {};
         for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
           {
+            if (broken_flag[b])
+              continue;
             const std::int32_t j = nb.col[b];
             double             xi[dim], r2 = 0., xe = 0.;
             for (unsigned int d = 0; d < dim; ++d)
@@ -155,6 +175,8 @@ namespace PeriDEAL
         double              w     = 0.;
         for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
           {
+            if (broken_flag[b])
+              continue;
             const std::int32_t j  = nb.col[b];
             double             r2 = 0., xe = 0.;
             for (unsigned int d = 0; d < dim; ++d)
@@ -183,6 +205,62 @@ namespace PeriDEAL
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       e += W.local_element(i) * disc.volume[i];
     return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::break_bonds(const VectorField &u)
+  {
+    const auto &nb = disc.neighborhood;
+    const auto &x  = disc.position;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+        {
+          if (broken_flag[b])
+            continue;
+          // xi and eta from positions so that row j's copy computes the
+          // bitwise same stretch (both factors change sign).
+          const std::int32_t j  = nb.col[b];
+          double             r2 = 0., xe = 0.;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double xi = x[j][d] - x[i][d];
+              r2 += xi * xi;
+              xe += xi * (u[d].local_element(j) - u[d].local_element(i));
+            }
+          if (xe / r2 > s0)
+            broken_flag[b] = 1;
+        }
+  }
+
+  template <int dim>
+  std::uint64_t
+  LinearizedLPSOperator<dim>::n_broken_bonds() const
+  {
+    std::uint64_t n = 0;
+    for (const auto f : broken_flag)
+      n += f;
+    return Utilities::MPI::sum(n, disc.get_mpi_communicator());
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::damage(Vector &phi) const
+  {
+    const auto &nb = disc.neighborhood;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i];
+        const double       *w     = nb.bond_weight.data() + nb.table_start[i];
+        double              all = 0., intact = 0.;
+        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+          {
+            all += w[b - begin];
+            if (!broken_flag[b])
+              intact += w[b - begin];
+          }
+        phi.local_element(i) = all > 0. ? 1. - intact / all : 0.;
+      }
   }
 
   template class LinearizedLPSOperator<2>;

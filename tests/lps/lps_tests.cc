@@ -4,7 +4,9 @@
 // the Navier operator, and rank-count invariance.
 
 #include <perideal/discretization/discretization.h>
+#include <perideal/models/bond_based.h>
 #include <perideal/models/lps.h>
+#include <perideal/models/stiffness.h>
 
 #include "../check.h"
 
@@ -443,6 +445,162 @@ namespace
     energy_gradient_case<3>();
   }
 
+
+  // Critical time step of LPS from the Gershgorin bound of the assembled
+  // stiffness, checked against an independent estimate of lambda_max(K)
+  // (power iteration) and explicit Verlet runs on the matrix-free forces.
+  void
+  time_step()
+  {
+    const double rho = 7.;
+    LatticeParameters lp;
+    lp.dx    = 0.1;
+    lp.delta = 0.3;
+    Discretization<2> disc(MPI_COMM_WORLD);
+    disc.setup(BoxDomain<2>(Point<2>(), Point<2>(1., 1.)), lp);
+    LPSModelParameters p;
+    p.bulk_modulus  = K;
+    p.shear_modulus = G;
+    LinearizedLPSOperator<2>       op(disc, p);
+    TrilinosWrappers::SparseMatrix Km;
+    Stiffness::assemble(op, Km);
+    const double dt_c = Stiffness::critical_time_step(Km, rho);
+
+    // lambda_max by power iteration (an underestimate, so dt_est >= the
+    // true critical step 2 sqrt(rho / lambda_max)).
+    TrilinosWrappers::MPI::Vector x(Stiffness::owned_dofs(disc), MPI_COMM_WORLD), y(x);
+    for (const auto k : x.locally_owned_elements())
+      x[k] = std::sin(1.3 * k + 0.7);
+    x.compress(VectorOperation::insert);
+    double lambda = 0.;
+    for (unsigned int it = 0; it < 2000; ++it)
+      {
+        x /= x.l2_norm();
+        Km.vmult(y, x);
+        lambda = x * y;
+        x      = y;
+      }
+    const double dt_est = 2. * std::sqrt(rho / lambda);
+    check(dt_c <= dt_est, "Gershgorin dt_c = " + sci(dt_c) + " <= 2 sqrt(rho/lambda_max) = " +
+                            sci(dt_est) + " (ratio " + sci(dt_c / dt_est) + ")");
+    // Measured ratio 0.6-0.7: the bound is not uselessly conservative.
+    check(dt_c >= 0.5 * dt_est, "dt_c >= 0.5 x the eigenvalue step");
+
+    // Verlet on the matrix-free forces from a random displacement.
+    auto run = [&](const double dt) {
+      typename LinearizedLPSOperator<2>::VectorField u, v, a;
+      op.initialize(u);
+      op.initialize(v);
+      op.initialize(a);
+      for (unsigned int i = 0; i < disc.n_owned() + disc.n_ghost(); ++i)
+        for (unsigned int d = 0; d < 2; ++d)
+          u[d].local_element(i) = 1e-3 * std::sin(17.1 * disc.id[i] + 3.3 * d);
+      const double u0 = u[0].linfty_norm();
+      op.compute_forces(u, a);
+      for (unsigned int step = 0; step < 300; ++step)
+        {
+          for (unsigned int d = 0; d < 2; ++d)
+            for (unsigned int i = 0; i < disc.n_owned(); ++i)
+              {
+                v[d].local_element(i) += 0.5 * dt * a[d].local_element(i) / rho;
+                u[d].local_element(i) += dt * v[d].local_element(i);
+              }
+          for (auto &c : u)
+            c.update_ghost_values();
+          op.compute_forces(u, a);
+          for (unsigned int d = 0; d < 2; ++d)
+            for (unsigned int i = 0; i < disc.n_owned(); ++i)
+              v[d].local_element(i) += 0.5 * dt * a[d].local_element(i) / rho;
+        }
+      return std::max(u[0].linfty_norm(), u[1].linfty_norm()) / u0;
+    };
+    const double g_stable = run(dt_c), g_unstable = run(1.05 * dt_est);
+    check(g_stable < 10., "Verlet at dt_c: max|u|/max|u0| = " + sci(g_stable) + " after 300 steps");
+    check(g_unstable > 1e6, "Verlet at 1.05 x 2 sqrt(rho/lambda_max): max|u|/max|u0| = " +
+                              sci(g_unstable) + " (diverges)");
+  }
+
+  // Bond breaking of LPS: the critical stretch criterion on the linearized
+  // stretch, irreversibility, damage (2.36), and the cut bonds of a jump
+  // field counted independently by the bond-based pre-crack (segment
+  // intersection) on the same lattice.
+  void
+  breaking()
+  {
+    LatticeParameters lp;
+    lp.dx    = 0.1;
+    lp.delta = 0.3;
+    Discretization<2> disc(MPI_COMM_WORLD);
+    disc.setup(BoxDomain<2>(Point<2>(-1., -0.5), Point<2>(1., 0.5)), lp);
+    const double       s0 = 1e-4, xc = 0.05;
+    LPSModelParameters p;
+    p.bulk_modulus     = K;
+    p.shear_modulus    = G;
+    p.critical_stretch = s0;
+    typename LinearizedLPSOperator<2>::VectorField u, f;
+    {
+      // Uniform expansion: every bond has stretch eps.
+      LinearizedLPSOperator<2> op(disc, p);
+      op.initialize(u);
+      op.initialize(f);
+      set_field<2>(disc, [&](const Point<2> &x) { return Tensor<1, 2>(0.99 * s0 * x); }, u);
+      op.compute_forces(u, f);
+      check(op.n_broken_bonds() == 0, "stretch 0.99 s0: no bond breaks");
+      set_field<2>(disc, [&](const Point<2> &x) { return Tensor<1, 2>(1.01 * s0 * x); }, u);
+      op.compute_forces(u, f);
+      check(op.n_broken_bonds() == disc.n_global_bonds(),
+            "stretch 1.01 s0: all " + std::to_string(disc.n_global_bonds()) + " bonds break");
+      check(std::max(f[0].linfty_norm(), f[1].linfty_norm()) == 0., "force 0 without bonds");
+      PeriDEAL::Vector phi;
+      disc.initialize_vector(phi);
+      op.damage(phi);
+      check(phi.linfty_norm() == 1. && phi.mean_value() == 1., "damage 1 everywhere");
+    }
+    // A jump of the x displacement across x = xc.
+    LinearizedLPSOperator<2> op(disc, p);
+    set_field<2>(disc, [&](const Point<2> &x) { return Tensor<1, 2>({x[0] > xc ? 1e-2 : 0., 0.}); },
+                 u);
+    {
+      LPSModelParameters intact = p;
+      intact.critical_stretch   = 0.;
+      LinearizedLPSOperator<2> op0(disc, intact);
+      op0.compute_forces(u, f);
+      check(f[0].linfty_norm() > 1e-3, "intact: the jump loads the bonds (max|f_x| = " +
+                                         sci(f[0].linfty_norm()) + ")");
+    }
+    op.compute_forces(u, f);
+    BondBasedModelParameters bp;
+    BondBasedOperator<2>     cut(disc, bp);
+    cut.add_precrack(Point<2>(xc, -10.), Point<2>(xc, 10.));
+    check(op.n_broken_bonds() == cut.n_broken_bonds() && cut.n_broken_bonds() > 0,
+          std::to_string(op.n_broken_bonds()) + " broken bonds = " +
+            std::to_string(cut.n_broken_bonds()) + " bonds crossing x = xc");
+    const double fmax = std::max(f[0].linfty_norm(), f[1].linfty_norm());
+    check(fmax == 0., "after breaking the two rigid halves exert no force: max|f| = " + sci(fmax));
+    PeriDEAL::Vector phi, phi_cut;
+    disc.initialize_vector(phi);
+    disc.initialize_vector(phi_cut);
+    op.damage(phi);
+    cut.damage(phi_cut);
+    double diff = 0., far = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        diff = std::max(diff, std::abs(phi.local_element(i) - phi_cut.local_element(i)));
+        if (std::abs(disc.position[i][0] - xc) > lp.delta + lp.dx)
+          far = std::max(far, phi.local_element(i));
+      }
+    diff = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    far  = Utilities::MPI::max(far, MPI_COMM_WORLD);
+    check(diff < 1e-15, "damage equals the pre-crack damage (max diff " + sci(diff) + ")");
+    check(far == 0., "damage 0 farther than delta + dx from the cut");
+    check(phi.linfty_norm() > 0.3, "max damage at the cut " + sci(phi.linfty_norm()));
+    // Irreversible: unloading does not heal.
+    set_field<2>(disc, [](const Point<2> &) { return Tensor<1, 2>(); }, u);
+    const auto n = op.n_broken_bonds();
+    op.compute_forces(u, f);
+    check(op.n_broken_bonds() == n, "unloading keeps the broken bonds");
+  }
+
   void
   rank_invariance()
   {
@@ -459,5 +617,7 @@ main(int argc, char **argv)
               {"rigid_motion", rigid_motion},
               {"navier", navier},
               {"energy_gradient", energy_gradient},
-              {"rank_invariance", rank_invariance}});
+              {"rank_invariance", rank_invariance},
+              {"time_step", time_step},
+              {"breaking", breaking}});
 }

@@ -7,3 +7,8 @@ perideal_add_test(NAME lps.homogeneous.np2 NPROCS 2
   COMMAND $<TARGET_FILE:lps_tests> homogeneous LABELS "unit;mpi")
 perideal_add_test(NAME lps.rank_invariance.np2 NPROCS 2
   COMMAND $<TARGET_FILE:lps_tests> rank_invariance LABELS mpi)
+foreach(_t time_step breaking)
+  perideal_add_test(NAME lps.${_t} COMMAND $<TARGET_FILE:lps_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME lps.breaking.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:lps_tests> breaking LABELS "unit;mpi")

@@ -136,6 +136,21 @@ namespace PeriDEAL
     {
       return disc;
     }
+    /** True for the linearized bond force (2.32). */
+    bool
+    is_linearized() const
+    {
+      return linearized;
+    }
+    /**
+     * c omega(min(|xi|, delta)) beta V_j per entry of the Neighborhood bond
+     * tables (row i uses the slice starting at table_start[i]).
+     */
+    const std::vector<double> &
+    bond_coefficients() const
+    {
+      return bond_coefficient;
+    }
 
     /** Zero-initialized dim node Vectors. */
     void

@@ -7,6 +7,7 @@
 #include <perideal/discretization/discretization.h>
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace PeriDEAL
@@ -25,6 +26,11 @@ namespace PeriDEAL
     double bulk_modulus = 1.;
     /** Shear modulus G (> 0). */
     double shear_modulus = 1.;
+    /**
+     * Critical stretch s0 of the bond-breaking criterion (2.34) applied to
+     * the linearized stretch xi . eta / |xi|^2; 0: bonds never break.
+     */
+    double critical_stretch = 0.;
 
     /** Declare the "Model" entries of the LPS model. */
     static void
@@ -71,6 +77,14 @@ namespace PeriDEAL
    * operator (K + G/3) grad div u + G Laplace u in both cases. 1D is not
    * provided.
    *
+   * Bond breaking: with a critical stretch s0 > 0, compute_forces() first
+   * breaks (irreversibly, one flag per CSR bond as in BondBasedOperator) every
+   * bond whose linearized stretch xi . eta / |xi|^2 exceeds s0; broken bonds
+   * are left out of theta and of the force. The weighted volume m_i keeps
+   * its undamaged value (the convention of Peridigm's LPS), so a node that
+   * lost bonds still has a consistent scale. Both copies of a bond see the
+   * bitwise same stretch and break together, on any rank layout.
+   *
    * theta_j of ghost neighbours is needed: compute_forces() computes theta
    * on the owned nodes and updates its ghosts before the force pass; m_j of
    * the ghosts is exchanged once in the constructor.
@@ -115,6 +129,16 @@ namespace PeriDEAL
       return m;
     }
 
+    /**
+     * omega(min(|xi|, delta)) beta V_j per entry of the Neighborhood bond
+     * tables (row i uses the slice starting at table_start[i]).
+     */
+    const std::vector<double> &
+    bond_coefficients() const
+    {
+      return bond_coefficient;
+    }
+
     /** Zero-initialized dim node Vectors. */
     void
     initialize(VectorField &field) const;
@@ -134,6 +158,28 @@ namespace PeriDEAL
     void
     compute_forces(const VectorField &u, VectorField &force);
 
+    /** The critical stretch (infinity if bonds never break). */
+    double
+    critical_stretch() const
+    {
+      return s0;
+    }
+
+    /** Broken flag (1 broken) per CSR bond of the owned rows. */
+    const std::vector<std::uint8_t> &
+    broken() const
+    {
+      return broken_flag;
+    }
+
+    /** Global number of broken bond copies (each bond counts once per owned row). */
+    std::uint64_t
+    n_broken_bonds() const;
+
+    /** Damage (2.36) 1 - sum mu beta V / sum beta V of the owned nodes. */
+    void
+    damage(Vector &phi) const;
+
     /** theta of the last compute_forces() (owned and ghost entries). */
     const Vector &
     dilatation() const
@@ -150,12 +196,17 @@ namespace PeriDEAL
     total_strain_energy(const VectorField &u) const;
 
   private:
+    /** Break the owned-row bonds whose linearized stretch exceeds s0. */
+    void
+    break_bonds(const VectorField &u);
+
     const Discretization<dim> &disc;
-    double                     K_d, G;
+    double                     K_d, G, s0;
     /** omega(min(|xi|, delta)) beta V_j per table entry. */
     std::vector<double> bond_coefficient;
     Vector              m;
     Vector              theta;
+    std::vector<std::uint8_t> broken_flag;
   };
 } // namespace PeriDEAL
 

@@ -1,0 +1,416 @@
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/timer.h>
+
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_solver.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/base/expressions.h>
+#include <perideal/io/node_output.h>
+#include <perideal/models/stiffness.h>
+#include <perideal/time_stepping/static_mechanics.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+namespace PeriDEAL
+{
+  namespace
+  {
+    // A parsed muparser expression of x, y, z as a function object; a
+    // shared_ptr because FunctionParser is not copyable.
+    template <int dim>
+    std::shared_ptr<FunctionParser<dim>>
+    parse_expressions(const std::vector<std::string> &parts, const std::string &parameter)
+    {
+      auto f = std::make_shared<FunctionParser<dim>>(parts.size());
+      try
+        {
+          f->initialize(FunctionParser<dim>::default_variable_names(), parts,
+                        expression_constants(dim));
+          for (unsigned int c = 0; c < parts.size(); ++c)
+            f->value(Point<dim>(), c);
+        }
+      catch (std::exception &)
+        {
+          std::string text;
+          for (const auto &part : parts)
+            text += (text.empty() ? "" : "; ") + part;
+          throw ParameterError(parameter, text, "muparser expressions in x, y, z");
+        }
+      return f;
+    }
+
+    // "f1; f2[; f3]" (the first dim are used) as a vector field.
+    template <int dim>
+    typename StaticMechanicsParameters<dim>::Field
+    vector_field(const std::string &text, const std::string &parameter)
+    {
+      auto parts = Utilities::split_string_list(text, ';');
+      check_parameter(parts.size() >= dim, parameter, text,
+                      std::to_string(dim) + " expressions separated by ';'");
+      parts.resize(dim);
+      const auto f = parse_expressions<dim>(parts, parameter);
+      return [f](const Point<dim> &x) {
+        Tensor<1, dim> v;
+        for (unsigned int d = 0; d < dim; ++d)
+          v[d] = f->value(x, d);
+        return v;
+      };
+    }
+  } // namespace
+
+  template <int dim>
+  void
+  StaticMechanicsParameters<dim>::declare_parameters(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Model");
+    prm.enter_subsection("LPS");
+    LPSModelParameters::declare_parameters(prm);
+    prm.leave_subsection();
+    prm.leave_subsection();
+
+    prm.enter_subsection("Static mechanics");
+    prm.declare_entry("Model", "LPS", Patterns::Selection("linearized bond-based|LPS"),
+                      "Linearized bond-based (2.32), entries in Model/Bond-based (its "
+                      "'Linearized' entry is implied), or linearized LPS (2.18)-(2.19), "
+                      "entries in Model/LPS (2D: plane strain).");
+    prm.declare_entry("Body force", "0; 0; 0", Patterns::Anything(),
+                      "Body force density b, 'dim' expressions in x, y, z separated by ';'.");
+    prm.declare_entry("Layer displacement", "0; 0; 0", Patterns::Anything(),
+                      "Displacement prescribed on the volume-constraint layer "
+                      "(Discretization/Volume constraint layer > 0).");
+    prm.declare_entry("Prescribed displacements", "", Patterns::Anything(),
+                      "Further node sets of the body with prescribed displacement: items "
+                      "'LEVEL SET : UX; UY[; UZ]' separated by '|'; the set is "
+                      "{LEVEL SET <= 0}; later items override earlier ones.");
+    prm.declare_entry("Solver", "cg-amg", Patterns::Selection("cg-amg|direct"),
+                      "CG with algebraic multigrid (Trilinos ML) or a direct solver (Amesos).");
+    prm.declare_entry("Tolerance", "1e-10", Patterns::Double(),
+                      "CG: relative residual reduction (0 < tol < 1).");
+    prm.declare_entry("Max iterations", "10000", Patterns::Integer(1), "CG iteration limit.");
+    prm.leave_subsection();
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsParameters<dim>::parse_parameters(ParameterHandler &p)
+  {
+    check_parameter(dim >= 2, "Dimension", dim, "2 or 3 for Problem = static mechanics");
+    p.enter_subsection("Geometry");
+    domain = Domain<dim>::create(p);
+    p.leave_subsection();
+    p.enter_subsection("Discretization");
+    lattice.parse_parameters(p);
+    p.leave_subsection();
+
+    p.enter_subsection("Static mechanics");
+    model = p.get("Model");
+    body_force = vector_field<dim>(p.get("Body force"), "Static mechanics/Body force");
+    layer_displacement =
+      vector_field<dim>(p.get("Layer displacement"), "Static mechanics/Layer displacement");
+    prescribed_displacements.clear();
+    for (const auto &item : Utilities::split_string_list(p.get("Prescribed displacements"), '|'))
+      {
+        const std::string name  = "Static mechanics/Prescribed displacements";
+        const auto        colon = item.find(':');
+        check_parameter(colon != std::string::npos, name, item,
+                        "items 'LEVEL SET : UX; UY[; UZ]' separated by '|'");
+        const auto set = parse_expressions<dim>({item.substr(0, colon)}, name);
+        prescribed_displacements.emplace_back(
+          [set](const Point<dim> &x) { return set->value(x); },
+          vector_field<dim>(item.substr(colon + 1), name));
+      }
+    solver         = p.get("Solver");
+    tolerance      = p.get_double("Tolerance");
+    max_iterations = p.get_integer("Max iterations");
+    check_parameter(tolerance > 0. && tolerance < 1., "Static mechanics/Tolerance", tolerance,
+                    "0 < tolerance < 1");
+    p.leave_subsection();
+
+    p.enter_subsection("Model");
+    p.enter_subsection("Bond-based");
+    bond_based.parse_parameters(p);
+    bond_based.linearized = true;
+    p.leave_subsection();
+    p.enter_subsection("LPS");
+    lps.parse_parameters(p);
+    p.leave_subsection();
+    p.leave_subsection();
+    // The static solve is linear: no bond breaking.
+    if (model == "LPS")
+      check_parameter(lps.critical_stretch == 0., "Model/LPS/Critical stretch",
+                      lps.critical_stretch, "0 for Problem = static mechanics (linear solve)");
+    else
+      check_parameter(bond_based.critical_stretch == 0. && bond_based.fracture_energy == 0.,
+                      "Model/Bond-based/Critical stretch, Fracture energy",
+                      bond_based.critical_stretch + bond_based.fracture_energy,
+                      "0 for Problem = static mechanics (linear solve)");
+
+    p.enter_subsection("Output");
+    output_directory = p.get("Directory");
+    p.leave_subsection();
+  }
+
+  template <int dim>
+  StaticMechanicsSolver<dim>::StaticMechanicsSolver(const MPI_Comm                        comm,
+                                                    const StaticMechanicsParameters<dim> &p)
+    : mpi_communicator(comm)
+    , prm(p)
+    , disc(comm)
+  {
+    check_parameter(prm.model == "LPS" || prm.model == "linearized bond-based",
+                    "Static mechanics/Model", prm.model, "linearized bond-based|LPS");
+    check_parameter(prm.solver == "cg-amg" || prm.solver == "direct", "Static mechanics/Solver",
+                    prm.solver, "cg-amg|direct");
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsSolver<dim>::setup()
+  {
+    AssertThrow(prm.domain, ExcMessage("StaticMechanicsParameters: no domain"));
+    disc.setup(*prm.domain, prm.lattice);
+    if (prm.model == "LPS")
+      lps = std::make_unique<LinearizedLPSOperator<dim>>(disc, prm.lps);
+    else
+      {
+        auto bb       = prm.bond_based;
+        bb.linearized = true;
+        bond_based    = std::make_unique<BondBasedOperator<dim>>(disc, bb);
+      }
+
+    // Prescribed nodes: the layer, then the node sets (later ones win).
+    const unsigned int n = disc.n_owned() + disc.n_ghost();
+    fixed.assign(n, 0);
+    prescribed.assign(n, Tensor<1, dim>());
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        const Point<dim> &x = disc.position[i];
+        if (disc.region[i] == Discretization<dim>::constrained && prm.layer_displacement)
+          {
+            fixed[i]      = 1;
+            prescribed[i] = prm.layer_displacement(x);
+          }
+        for (const auto &set : prm.prescribed_displacements)
+          if (set.first(x) <= 0.)
+            {
+              fixed[i]      = 1;
+              prescribed[i] = set.second(x);
+            }
+      }
+    std::uint64_t n_fixed = 0;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      n_fixed += fixed[i];
+    check_parameter(Utilities::MPI::sum(n_fixed, mpi_communicator) > 0,
+                    "Discretization/Volume constraint layer, Static mechanics/Prescribed "
+                    "displacements",
+                    "no prescribed node",
+                    "a constraint layer or node set that removes the rigid-body modes");
+    for (auto &c : u)
+      disc.initialize_vector(c);
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsSolver<dim>::compute_forces(const VectorField &v, VectorField &f)
+  {
+    if (lps)
+      lps->compute_forces(v, f);
+    else
+      bond_based->compute_forces(v, f);
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsSolver<dim>::assemble(TrilinosWrappers::SparseMatrix   &matrix,
+                                       const std::vector<unsigned char> &fixed_mask) const
+  {
+    if (lps)
+      Stiffness::assemble(*lps, matrix, fixed_mask);
+    else
+      Stiffness::assemble(*bond_based, matrix, fixed_mask);
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsSolver<dim>::solve()
+  {
+    Timer                          timer;
+    TrilinosWrappers::SparseMatrix K;
+    assemble(K, fixed);
+
+    // u_C: prescribed values on fixed nodes, 0 elsewhere; f(u_C) = -K u_C.
+    VectorField uc, f, rhs_field;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        disc.initialize_vector(uc[d]);
+        disc.initialize_vector(f[d]);
+        disc.initialize_vector(rhs_field[d]);
+      }
+    for (unsigned int i = 0; i < disc.n_owned() + disc.n_ghost(); ++i)
+      if (fixed[i])
+        for (unsigned int d = 0; d < dim; ++d)
+          uc[d].local_element(i) = prescribed[i][d];
+    compute_forces(uc, f);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const Tensor<1, dim> b = fixed[i] ? prescribed[i] : prm.body_force(disc.position[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          rhs_field[d].local_element(i) = fixed[i] ? b[d] : b[d] + f[d].local_element(i);
+      }
+
+    const IndexSet                owned = Stiffness::owned_dofs(disc);
+    TrilinosWrappers::MPI::Vector rhs(owned, mpi_communicator), x(rhs), res(rhs);
+    Stiffness::to_dofs(disc, rhs_field, rhs);
+    // Initial guess: the prescribed values (exact on the fixed rows).
+    Stiffness::to_dofs(disc, uc, x);
+
+    SolverControl control(prm.max_iterations, prm.tolerance * rhs.l2_norm());
+    if (prm.solver == "direct")
+      {
+        TrilinosWrappers::SolverDirect direct(control);
+        direct.solve(K, x, rhs);
+        iterations = 1;
+      }
+    else
+      {
+        TrilinosWrappers::PreconditionAMG                 amg;
+        TrilinosWrappers::PreconditionAMG::AdditionalData data;
+        data.elliptic = true;
+        // Translations per component as the near-null space.
+        data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
+        for (unsigned int k = 0; k < owned.n_elements(); ++k)
+          data.constant_modes[k % dim][k] = true;
+        amg.initialize(K, data);
+        TrilinosWrappers::SolverCG cg(control);
+        cg.solve(K, x, rhs, amg);
+        iterations = control.last_step();
+      }
+    K.vmult(res, x);
+    res -= rhs;
+    residual = res.l2_norm() / std::max(rhs.l2_norm(), std::numeric_limits<double>::min());
+    Stiffness::from_dofs(disc, x, u);
+    solve_seconds = timer.wall_time();
+  }
+
+  template <int dim>
+  double
+  StaticMechanicsSolver<dim>::strain_energy() const
+  {
+    return lps ? lps->total_strain_energy(u) : bond_based->total_strain_energy(u);
+  }
+
+  template <int dim>
+  Tensor<1, dim>
+  StaticMechanicsSolver<dim>::reaction_force()
+  {
+    VectorField f;
+    for (auto &c : f)
+      disc.initialize_vector(c);
+    compute_forces(u, f);
+    Tensor<1, dim> r;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (fixed[i])
+        for (unsigned int d = 0; d < dim; ++d)
+          r[d] -= f[d].local_element(i) * disc.volume[i];
+    return Utilities::MPI::sum(r, mpi_communicator);
+  }
+
+  template <int dim>
+  Tensor<1, dim>
+  StaticMechanicsSolver<dim>::total_body_force() const
+  {
+    Tensor<1, dim> s;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (!fixed[i])
+        s += prm.body_force(disc.position[i]) * disc.volume[i];
+    return Utilities::MPI::sum(s, mpi_communicator);
+  }
+
+  template <int dim>
+  void
+  StaticMechanicsSolver<dim>::output()
+  {
+    if (prm.output_directory.empty())
+      return;
+    Vector magnitude;
+    disc.initialize_vector(magnitude);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        double s = 0.;
+        for (unsigned int d = 0; d < dim; ++d)
+          s += u[d].local_element(i) * u[d].local_element(i);
+        magnitude.local_element(i) = std::sqrt(s);
+      }
+    std::vector<std::pair<std::string, const Vector *>> fields;
+    const char *names[3] = {"u_x", "u_y", "u_z"};
+    for (unsigned int d = 0; d < dim; ++d)
+      fields.emplace_back(names[d], &u[d]);
+    fields.emplace_back("u_magnitude", &magnitude);
+    NodeOutput<dim> vtu(disc, prm.output_directory, "solution");
+    vtu.write(0., 0, fields);
+
+    // Collective quantities on every rank, written by rank 0.
+    const double  energy   = strain_energy();
+    const auto    reaction = reaction_force();
+    const auto    body     = total_body_force();
+    const auto    n_bonds  = disc.n_global_bonds();
+    if (Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
+      {
+        std::ofstream out(prm.output_directory + "/summary.txt");
+        out << std::setprecision(12);
+        out << "model: " << prm.model << "\ndimension: " << dim
+            << "\nnodes: " << disc.n_global() << "\nbonds: " << n_bonds
+            << "\nsolver: " << prm.solver << "\niterations: " << iterations
+            << "\nrelative_residual: " << residual << "\nsolve_seconds: " << solve_seconds
+            << "\nstrain_energy: " << energy;
+        for (unsigned int d = 0; d < dim; ++d)
+          out << "\nreaction_force_" << names[d] + 2 << ": " << reaction[d];
+        for (unsigned int d = 0; d < dim; ++d)
+          out << "\nbody_force_" << names[d] + 2 << ": " << body[d];
+        out << "\n";
+      }
+  }
+
+  template <int dim>
+  void
+  run_static_mechanics(ParameterHandler &prm, const MPI_Comm comm)
+  {
+    if constexpr (dim == 1)
+      {
+        (void)prm;
+        (void)comm;
+        throw ParameterError("Dimension", "1", "2 or 3 for Problem = static mechanics");
+      }
+    else
+      {
+        StaticMechanicsParameters<dim> parameters;
+        parameters.parse_parameters(prm);
+        StaticMechanicsSolver<dim> solver(comm, parameters);
+        solver.setup();
+        solver.solve();
+        solver.output();
+        const double energy   = solver.strain_energy();
+        const auto   reaction = solver.reaction_force();
+        if (Utilities::MPI::this_mpi_process(comm) == 0)
+          std::cout << "Static " << parameters.model << " in " << dim << "D: "
+                    << solver.discretization().n_global() << " nodes, "
+                    << solver.n_iterations() << " iterations, relative residual "
+                    << solver.relative_residual() << ", strain energy " << energy
+                    << ", reaction force " << reaction << std::endl;
+      }
+  }
+
+  template void run_static_mechanics<1>(ParameterHandler &, const MPI_Comm);
+  template void run_static_mechanics<2>(ParameterHandler &, const MPI_Comm);
+  template void run_static_mechanics<3>(ParameterHandler &, const MPI_Comm);
+  template struct StaticMechanicsParameters<1>;
+  template struct StaticMechanicsParameters<2>;
+  template struct StaticMechanicsParameters<3>;
+  template class StaticMechanicsSolver<2>;
+  template class StaticMechanicsSolver<3>;
+} // namespace PeriDEAL
