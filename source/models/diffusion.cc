@@ -214,11 +214,26 @@ namespace PeriDEAL
   double
   DiffusionOperator<dim>::critical_time_step() const
   {
+    // Row-wise Gershgorin bound of the forward Euler iteration matrix
+    // I + dt L restricted to the unknowns: values on the volume-constraint
+    // layer are prescribed (they carry no error), so their couplings count
+    // in the diagonal |l_ii| but not in the disc radius R_i. The disc lies in
+    // [-1, 1] iff dt <= 2/(|l_ii| + R_i) (R_i <= |l_ii| always holds here).
+    // In the bulk R_i = |l_ii| and this is (16) of 003 with beta; with
+    // homogeneous Neumann ends (no layer) every row is of that kind.
     const double kappa_max = *std::max_element(kappa_table.begin(), kappa_table.end());
+    const auto  &nb        = disc.neighborhood;
     double       max_sum   = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (disc.region[i] == Discretization<dim>::interior)
-        max_sum = std::max(max_sum, kappa_max * row_sum[i]);
+        {
+          const double *w      = geometric_weight.data() + nb.table_start[i];
+          double        radius = 0.;
+          for (std::uint64_t k = nb.row_start[i]; k < nb.row_start[i + 1]; ++k)
+            if (disc.region[nb.col[k]] == Discretization<dim>::interior)
+              radius += w[k - nb.row_start[i]];
+          max_sum = std::max(max_sum, 0.5 * kappa_max * (row_sum[i] + radius));
+        }
     max_sum = Utilities::MPI::max(max_sum, disc.get_mpi_communicator());
     return max_sum > 0. ? 1. / max_sum : std::numeric_limits<double>::infinity();
   }

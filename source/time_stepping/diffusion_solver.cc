@@ -248,8 +248,13 @@ namespace PeriDEAL
         std::ostringstream bound;
         bound.precision(6);
         bound << "a value <= the forward Euler stability bound " << dt_critical
-              << " (Gershgorin bound 1/max_i sum_j kappa_ij w_ij of the discrete "
-                 "operator); use 'backward Euler' for larger steps";
+              << " (Gershgorin bound min_i 2/(|l_ii| + R_i) of the iteration matrix for "
+              << (disc.parameters().layer_thickness > 0. ?
+                    "Dirichlet values on the volume-constraint layer" :
+                    "homogeneous nonlocal Neumann ends")
+              << ", i.e. 1/max_i sum_j kappa_ij w_ij in the bulk, (16) of paper 003"
+              << (op->is_corrosion() ? ", with the largest micro-diffusivity" : "")
+              << "); use 'backward Euler' for larger steps";
         check_parameter(dt <= dt_critical * (1. + 1e-10), "Time stepping/Time step", dt,
                         bound.str());
       }
