@@ -103,15 +103,29 @@ namespace PeriDEAL
       modes.push_back({amplitude, wavenumber, decay_rate, basis});
     }
 
+    const std::vector<double> &
+    EigenExpansion::decay(const double t) const
+    {
+      if (t != cached_time || cached_decay.size() != modes.size())
+        {
+          cached_decay.resize(modes.size());
+          for (unsigned int i = 0; i < modes.size(); ++i)
+            cached_decay[i] = std::exp(-modes[i].lambda * t);
+          cached_time = t;
+        }
+      return cached_decay;
+    }
+
     double
     EigenExpansion::value(const double x, const double t) const
     {
-      double s = offset;
-      for (const auto &m : modes)
+      const auto &e = decay(t);
+      double      s = offset;
+      for (unsigned int i = 0; i < modes.size(); ++i)
         {
+          const auto  &m   = modes[i];
           const double arg = m.k * (x - origin);
-          s += m.a * (m.basis == Basis::cosine ? std::cos(arg) : std::sin(arg)) *
-               std::exp(-m.lambda * t);
+          s += m.a * (m.basis == Basis::cosine ? std::cos(arg) : std::sin(arg)) * e[i];
         }
       return s;
     }

@@ -445,11 +445,18 @@ namespace PeriDEAL
         rod.forward_euler_step(t, dt, C, src);
         const double xn = outer(C), xe = exact_interface(t);
         tr.max_interface_error = std::max(tr.max_interface_error, std::abs(xn - xe));
-        tr.monotone            = tr.monotone && xn <= previous + 1e-12;
+        tr.max_outward_step    = std::max(tr.max_outward_step, xn - previous);
         previous               = xn;
         for (unsigned int i = 0; i < C.size(); ++i)
-          tr.max_concentration_error =
-            std::max(tr.max_concentration_error, std::abs(C[i] - exact(rod.position(i), t)));
+          {
+            const double e = std::abs(C[i] - exact(rod.position(i), t));
+            if (e > tr.max_concentration_error)
+              {
+                tr.max_concentration_error = e;
+                tr.time_of_max_error       = t;
+                tr.position_of_max_error   = rod.position(i);
+              }
+          }
         if (s % record_every == 0 || s == steps)
           {
             tr.time.push_back(t);

@@ -407,7 +407,7 @@ subsection Discretization
     const auto zero      = [](const double) { return 0.; };
     const auto ref_c = [&](const double x, const double t) { return cont.value(x, t); };
     const auto ref_d = [&](const double x, const double t) { return disc.value(x, t); };
-    for (const unsigned int m : {2u, 4u, 8u, 16u})
+    for (const unsigned int m : {2u, 4u, 8u})
       {
         const SurfaceNodeRod r(rod(m, FictitiousExtrapolation::antisymmetric, true));
         const double         dt    = 0.25 * r.gershgorin_bound().time_step;
@@ -431,14 +431,41 @@ subsection Discretization
                 << rate_of(ec[k], ec[k + 1]) << ", discontinuous t0 = 1 ms "
                 << rate_of(ed1[k], ed1[k + 1]) << ", t0 = 0 " << rate_of(ed0[k], ed0[k + 1])
                 << std::endl;
-    const unsigned int l = ec.size() - 1;
-    for (unsigned int k = 0; k < l; ++k)
+    for (unsigned int k = 0; k + 1 < ec.size(); ++k)
       {
-        check(ec[k + 1] < ec[k] && ed1[k + 1] < ed1[k], "errors decrease with m");
+        const double rc = rate_of(ec[k], ec[k + 1]), rd = rate_of(ed1[k], ed1[k + 1]),
+                     r0 = rate_of(ed0[k], ed0[k + 1]);
         check(ed1[k] > ec[k], "discontinuous error exceeds continuous");
+        // Midpoint quadrature and the self-transfer are second order:
+        // observed 2.52, 2.35, 2.21 (pre-asymptotic, falling towards 2).
+        check(rc > 1.8 && rc < 2.8, "continuous rate in [1.8, 2.8]: " + str(rc));
+        // 003 Fig. 14: the same rate once the first 1 ms is skipped;
+        // catalog band +-0.3 (measured differences 0.18, 0.21, 0.18).
+        check(std::abs(rd - rc) <= 0.3, "discontinuous rate (t0 = 1 ms) within 0.3 of continuous");
+        // 003 Fig. 15: without skipping, the first steps dominate and the
+        // rate drops (measured 0.77, 0.64, -0.26).
+        check(r0 < 1., "discontinuous rate with t0 = 0 below 1: " + str(r0));
       }
-    // TODO bands after measurement
-    (void)l;
+
+    // 003 Sect. 4.2: with the linear Taylor extrapolation (mismatching the
+    // antisymmetric extension the analytical solutions assume) convergence
+    // is poor: the continuous case converges slowly and the discontinuous
+    // one does not decrease.
+    std::vector<double> lc, ld;
+    for (const unsigned int m : {2u, 4u, 8u})
+      {
+        const SurfaceNodeRod r(rod(m, FictitiousExtrapolation::linear_taylor, true));
+        const double         dt = 0.25 * r.gershgorin_bound().time_step;
+        lc.push_back(run_against_reference(r, quadratic, ref_c, dt, 0.5, true, Cbar).max_after(0.));
+        ld.push_back(run_against_reference(r, zero, ref_d, dt, 0.5, true, Cbar).max_after(1e-3));
+        std::cout << "  linear Taylor m = " << m << ": continuous " << lc.back()
+                  << ", discontinuous (t0 = 1 ms) " << ld.back() << std::endl;
+      }
+    // measured: continuous 5.5e-5, 1.1e-5, 9.7e-6 (stalls: rate 0.16 from 4 to 8);
+    // discontinuous 2.2e-3, 2.3e-3, 3.7e-3 (grows, the "slight divergence").
+    check(rate_of(lc[1], lc[2]) < 1., "linear Taylor, continuous: rate below 1 from m = 4 to 8");
+    check(ld[2] > ld[0], "linear Taylor, discontinuous: the error does not decrease");
+    check(ld[2] > 10. * ed1[2], "linear Taylor error >> antisymmetric error (m = 8)");
   }
 
   // 003 Sect. 5: half rod [0, l/2], symmetry at 0, SNM with linear Taylor
@@ -514,6 +541,7 @@ subsection Discretization
     check_close(ex.interface_position(0.), 0.474342, 1e-6, "x_i(0) (59)");
     check_close(ex.interface_position(0.25), 0.447214, 1e-6, "x_i(t_f/2)");
 
+    std::vector<double> interface_error, concentration_error;
     for (const unsigned int m : {4u, 8u, 16u})
       for (const bool literal : {false, true})
         {
@@ -521,14 +549,29 @@ subsection Discretization
           std::cout << "  m = " << m << (literal ? " (003's literal d2/d3)" : "")
                     << ", dt = 1e-5: interface error " << a.max_interface_error
                     << ", max concentration error " << a.max_concentration_error
-                    << ", x_i(0) numerical " << a.numerical[0] << std::endl;
-          if (m == 16 && !literal)
-            {
-              check(a.monotone, "numerical interface moves inward monotonically");
-              check(a.max_interface_error <= 2. * delta / 16,
-                    "interface within 2 dx of (59) for t <= 0.85 t_f");
-            }
+                    << " (t = " << a.time_of_max_error << ", x = " << a.position_of_max_error
+                    << "), largest outward step " << a.max_outward_step << std::endl;
+          if (literal)
+            continue;
+          interface_error.push_back(a.max_interface_error);
+          concentration_error.push_back(a.max_concentration_error);
+          const double dx = delta / m;
+          // The phase rule (6) is reversible and the source follows the
+          // numerical interface, so the node next to the interface may cross
+          // C_i back once: the interface flickers by one node (measured: one
+          // dx at every m); a drift outwards would exceed it.
+          check(a.max_outward_step <= dx * (1. + 1e-9),
+                "interface moves inward up to a one-node flicker, m = " + std::to_string(m));
+          // 2 dx: the catalog's suggested band; measured 1.86-1.90 dx.
+          check(a.max_interface_error <= 2. * dx,
+                "interface within 2 dx of (59) for t <= 0.85 t_f, m = " + std::to_string(m));
         }
+    // First-order convergence in dx of the interface and the concentration
+    // (the interface is resolved to one cell; measured ratios 3.9 and 3.5
+    // from m = 4 to 16): assert at least 3 (order >= 0.8).
+    check(interface_error[0] / interface_error[2] >= 3., "interface error converges with m");
+    check(concentration_error[0] / concentration_error[2] >= 3.,
+          "concentration error converges with m");
   }
 } // namespace
 

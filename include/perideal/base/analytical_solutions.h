@@ -110,6 +110,12 @@ namespace PeriDEAL
       };
       double            offset, origin;
       std::vector<Mode> modes;
+      /** exp(-lambda_m t) of the last t asked for (error sweeps over many x). */
+      mutable double              cached_time = -1.;
+      mutable std::vector<double> cached_decay;
+
+      const std::vector<double> &
+      decay(const double t) const;
     };
 
     /**

@@ -268,8 +268,12 @@ namespace PeriDEAL
   {
     std::vector<double> time, numerical, exact;
     double              max_interface_error = 0., max_concentration_error = 0.;
-    /** The numerical interface never moved outwards. */
-    bool monotone = true;
+    /** Largest outward step of the numerical interface (0: monotone inward). */
+    double max_outward_step = 0.;
+    /** Time of the largest concentration error. */
+    double time_of_max_error = 0.;
+    /** Position of the largest concentration error. */
+    double position_of_max_error = 0.;
   };
 
   InterfaceTrack
