@@ -85,6 +85,11 @@ namespace PeriDEAL
     prm.declare_entry("Saturation concentration", "0.85", Patterns::Double(),
                       "C_sat of (2.79): a solid node becomes liquid once its "
                       "concentration falls below it, and never turns back.");
+    prm.declare_entry("Phase rule", "one-way", Patterns::Selection("one-way|concentration"),
+                      "one-way: (2.79), solid to liquid only. concentration: the phase "
+                      "follows the current concentration (paper 003, eq. 6): solid "
+                      "(above the phase-change concentration = 'Saturation "
+                      "concentration') whenever C >= C_sat, liquid otherwise.");
     prm.leave_subsection();
   }
 
@@ -111,6 +116,7 @@ namespace PeriDEAL
     kappa_interface = prm.get_double("Interface micro-diffusivity");
     kappa_solid     = prm.get_double("Solid micro-diffusivity");
     saturation      = prm.get_double("Saturation concentration");
+    reversible_phase = prm.get("Phase rule") == "concentration";
     prm.leave_subsection();
     check_parameter(kappa_liquid >= 0., "Model/Corrosion/Liquid micro-diffusivity",
                     kappa_liquid, "a non-negative number");

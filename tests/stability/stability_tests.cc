@@ -573,6 +573,64 @@ subsection Discretization
     check(concentration_error[0] / concentration_error[2] >= 3.,
           "concentration error converges with m");
   }
+
+  // The library's corrosion model with the phase rule of 003 (6): a liquid
+  // rod (C = 0.5 < C_sat = 0.85) fed by a uniform source S = 1 turns solid
+  // when C reaches C_sat (t = 0.35) with the 'concentration' rule and stays
+  // liquid with the one-way rule (2.79). Uniform C: the operator is zero,
+  // so C = 0.5 + t exactly.
+  void
+  library_phase_rule()
+  {
+    for (const std::string rule : {"one-way", "concentration"})
+      {
+        const std::string text = R"(
+subsection Geometry
+  set Domain = box
+  set Lower corner = 0
+  set Upper corner = 1
+end
+subsection Discretization
+  set Grid spacing = 0.05
+end
+subsection Model
+  set Type = corrosion
+  set Initial condition = 0.5
+  set Source = 1
+  subsection Corrosion
+    set Phase rule = )" + rule + R"(
+  end
+end
+subsection Time stepping
+  set Time step = 0.001
+  set End time = 0.5
+end
+)";
+        ParameterHandler prm;
+        DiffusionRunParameters<1>::declare_parameters(prm);
+        prm.parse_input_from_string(text);
+        DiffusionRunParameters<1> p;
+        p.parse_parameters(prm);
+        DiffusionSolver<1> s(MPI_COMM_WORLD, p);
+        s.setup();
+        double t_solid = -1.;
+        while (s.step() < s.n_steps())
+          {
+            s.advance();
+            if (t_solid < 0. && s.diagnostics().solid_volume > 0.)
+              t_solid = s.time();
+          }
+        const double solid = s.diagnostics().solid_volume;
+        if (rule == "one-way")
+          check(solid == 0., "one-way rule (2.79): stays liquid");
+        else
+          {
+            check_close(solid, s.diagnostics().mass / s.solution().linfty_norm(), 1e-12,
+                        "concentration rule (6): the whole rod turned solid");
+            check_close(t_solid, 0.35, 0.01, "at C = C_sat, t = 0.35");
+          }
+      }
+  }
 } // namespace
 
 int
@@ -586,5 +644,6 @@ main(int argc, char **argv)
               {"analytical", analytical},
               {"snm_linear_field", snm_linear_field},
               {"convergence", convergence},
-              {"moving_interface", moving_interface}});
+              {"moving_interface", moving_interface},
+              {"library_phase_rule", library_phase_rule}});
 }

@@ -3,7 +3,7 @@
 perideal_add_test_program(stability_tests ${CMAKE_CURRENT_LIST_DIR}/stability_tests.cc)
 
 foreach(_t bounds_closed_form eigenvalue_bound divergence library_bound analytical snm_linear_field
-    moving_interface)
+    moving_interface library_phase_rule)
   perideal_add_test(NAME stability.${_t} COMMAND $<TARGET_FILE:stability_tests> ${_t}
     LABELS unit)
 endforeach()

@@ -41,6 +41,15 @@ namespace PeriDEAL
     double kappa_liquid = 1., kappa_interface = 0.1, kappa_solid = 0.;
     /** Corrosion: saturation concentration C_sat of (2.79). */
     double saturation = 0.85;
+    /**
+     * Corrosion: false (default) for the one-way rule (2.79) (solid turns
+     * liquid below C_sat, never back); true for the phase-change model of
+     * paper 003, eq. (6): a node is solid ("above C_i") whenever C >= C_sat
+     * at the end of a step, so the interface can move both ways. The bond
+     * table (liquid-liquid, interface, solid-solid) is the same; only a node
+     * exactly at C_sat differs ((6) makes all its bonds mixed).
+     */
+    bool reversible_phase = false;
 
     static void
     declare_parameters(ParameterHandler &prm);
