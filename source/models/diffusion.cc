@@ -85,6 +85,11 @@ namespace PeriDEAL
     prm.declare_entry("Saturation concentration", "0.85", Patterns::Double(),
                       "C_sat of (2.79): a solid node becomes liquid once its "
                       "concentration falls below it, and never turns back.");
+    prm.declare_entry("Phase rule", "one-way", Patterns::Selection("one-way|concentration"),
+                      "one-way: (2.79), solid to liquid only. concentration: the phase "
+                      "follows the current concentration (paper 003, eq. 6): solid "
+                      "(above the phase-change concentration = 'Saturation "
+                      "concentration') whenever C >= C_sat, liquid otherwise.");
     prm.leave_subsection();
   }
 
@@ -111,6 +116,7 @@ namespace PeriDEAL
     kappa_interface = prm.get_double("Interface micro-diffusivity");
     kappa_solid     = prm.get_double("Solid micro-diffusivity");
     saturation      = prm.get_double("Saturation concentration");
+    reversible_phase = prm.get("Phase rule") == "concentration";
     prm.leave_subsection();
     check_parameter(kappa_liquid >= 0., "Model/Corrosion/Liquid micro-diffusivity",
                     kappa_liquid, "a non-negative number");
@@ -214,11 +220,26 @@ namespace PeriDEAL
   double
   DiffusionOperator<dim>::critical_time_step() const
   {
+    // Row-wise Gershgorin bound of the forward Euler iteration matrix
+    // I + dt L restricted to the unknowns: values on the volume-constraint
+    // layer are prescribed (they carry no error), so their couplings count
+    // in the diagonal |l_ii| but not in the disc radius R_i. The disc lies in
+    // [-1, 1] iff dt <= 2/(|l_ii| + R_i) (R_i <= |l_ii| always holds here).
+    // In the bulk R_i = |l_ii| and this is (16) of 003 with beta; with
+    // homogeneous Neumann ends (no layer) every row is of that kind.
     const double kappa_max = *std::max_element(kappa_table.begin(), kappa_table.end());
+    const auto  &nb        = disc.neighborhood;
     double       max_sum   = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (disc.region[i] == Discretization<dim>::interior)
-        max_sum = std::max(max_sum, kappa_max * row_sum[i]);
+        {
+          const double *w      = geometric_weight.data() + nb.table_start[i];
+          double        radius = 0.;
+          for (std::uint64_t k = nb.row_start[i]; k < nb.row_start[i + 1]; ++k)
+            if (disc.region[nb.col[k]] == Discretization<dim>::interior)
+              radius += w[k - nb.row_start[i]];
+          max_sum = std::max(max_sum, 0.5 * kappa_max * (row_sum[i] + radius));
+        }
     max_sum = Utilities::MPI::max(max_sum, disc.get_mpi_communicator());
     return max_sum > 0. ? 1. / max_sum : std::numeric_limits<double>::infinity();
   }

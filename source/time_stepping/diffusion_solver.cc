@@ -248,8 +248,13 @@ namespace PeriDEAL
         std::ostringstream bound;
         bound.precision(6);
         bound << "a value <= the forward Euler stability bound " << dt_critical
-              << " (Gershgorin bound 1/max_i sum_j kappa_ij w_ij of the discrete "
-                 "operator); use 'backward Euler' for larger steps";
+              << " (Gershgorin bound min_i 2/(|l_ii| + R_i) of the iteration matrix for "
+              << (disc.parameters().layer_thickness > 0. ?
+                    "Dirichlet values on the volume-constraint layer" :
+                    "homogeneous nonlocal Neumann ends")
+              << ", i.e. 1/max_i sum_j kappa_ij w_ij in the bulk, (16) of paper 003"
+              << (op->is_corrosion() ? ", with the largest micro-diffusivity" : "")
+              << "); use 'backward Euler' for larger steps";
         check_parameter(dt <= dt_critical * (1. + 1e-10), "Time stepping/Time step", dt,
                         bound.str());
       }
@@ -402,11 +407,18 @@ namespace PeriDEAL
   {
     bool changed = false;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      if (phase.local_element(i) > 0.5 && C.local_element(i) < prm.model.saturation)
-        {
-          phase.local_element(i) = 0.;
-          changed                = true;
-        }
+      {
+        const bool solid = phase.local_element(i) > 0.5;
+        // one-way (2.79): solid -> liquid below C_sat; 003 (6): both ways
+        const bool to_liquid = solid && C.local_element(i) < prm.model.saturation;
+        const bool to_solid  = prm.model.reversible_phase && !solid &&
+                              C.local_element(i) >= prm.model.saturation;
+        if (to_liquid || to_solid)
+          {
+            phase.local_element(i) = to_solid ? 1. : 0.;
+            changed                = true;
+          }
+      }
     phase.update_ghost_values();
     if (Utilities::MPI::logical_or(changed, mpi_communicator))
       matrix_valid = false;

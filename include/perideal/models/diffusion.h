@@ -8,7 +8,9 @@
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
 
+#include <algorithm>
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,12 +41,64 @@ namespace PeriDEAL
     double kappa_liquid = 1., kappa_interface = 0.1, kappa_solid = 0.;
     /** Corrosion: saturation concentration C_sat of (2.79). */
     double saturation = 0.85;
+    /**
+     * Corrosion: false (default) for the one-way rule (2.79) (solid turns
+     * liquid below C_sat, never back); true for the phase-change model of
+     * paper 003, eq. (6): a node is solid ("above C_i") whenever C >= C_sat
+     * at the end of a step, so the interface can move both ways. The bond
+     * table (liquid-liquid, interface, solid-solid) is the same; only a node
+     * exactly at C_sat differs ((6) makes all its bonds mixed).
+     */
+    bool reversible_phase = false;
 
     static void
     declare_parameters(ParameterHandler &prm);
     /** The caller has entered "Model". */
     void
     parse_parameters(ParameterHandler &prm, const unsigned int dim);
+  };
+
+  /**
+   * Bond micro-diffusivity of a two-phase body whose phase follows the
+   * current concentration (paper 003, eq. 6): @p low if both end points are
+   * below the phase-change concentration C_i, @p high if both are above,
+   * @p mixed otherwise (one end at or across C_i). Unlike the corrosion model
+   * (2.79), where a node's phase is stored and changes one way only, the
+   * phase here is a function of C and may change back. With the corrosion
+   * model's names: low = liquid-liquid, high = solid-solid, mixed =
+   * interface.
+   */
+  struct PhaseChangeDiffusivity
+  {
+    double low = 1., high = 1., mixed = 1.;
+    /** C_i; +infinity: a single phase with diffusivity @p low. */
+    double threshold = std::numeric_limits<double>::infinity();
+
+    double
+    operator()(const double c_x, const double c_xp) const
+    {
+      if (c_x < threshold && c_xp < threshold)
+        return low;
+      if (c_x > threshold && c_xp > threshold)
+        return high;
+      return mixed;
+    }
+
+    /** The largest of the three (Remark 1 of 003: it bounds the time step). */
+    double
+    max() const
+    {
+      return std::max(low, std::max(high, mixed));
+    }
+
+    /** One phase with micro-diffusivity @p d. */
+    static PhaseChangeDiffusivity
+    single_phase(const double d)
+    {
+      PhaseChangeDiffusivity p;
+      p.low = p.high = p.mixed = d;
+      return p;
+    }
   };
 
   /**
@@ -87,10 +141,13 @@ namespace PeriDEAL
     apply(const Vector &C, Vector &rate, const Vector *phase = nullptr) const;
 
     /**
-     * Largest stable forward Euler step 1 / max_i sum_j |kappa_ij w_ij| from
-     * the Gershgorin bound on the discrete operator (003, eq. 16, here with
-     * beta and the actual bond coefficients). For corrosion the largest of
-     * the three kappas is used, which bounds every phase configuration.
+     * Largest forward Euler step the Gershgorin theorem proves stable for
+     * this boundary treatment: min_i 2 / (|l_ii| + R_i) over the rows of the
+     * unknowns, R_i the sum of the couplings to other unknowns (nodes of the
+     * volume-constraint layer are prescribed and carry no error). In the bulk
+     * this is 1 / sum_j kappa w_ij, (16) of 003 with beta and the actual bond
+     * coefficients. For corrosion the largest of the three kappas is used,
+     * which bounds every phase configuration (Remark 1 of 003).
      */
     double
     critical_time_step() const;
