@@ -286,7 +286,8 @@ namespace PeriDEAL
   MechanicsSolver<dim>::setup()
   {
     disc.setup(*prm.domain, prm.lattice);
-    op = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
+    n_global_bonds = disc.n_global_bonds();
+    op             = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
     for (const auto &crack : prm.precracks)
       op->add_precrack(crack);
 
@@ -447,7 +448,7 @@ namespace PeriDEAL
   double
   MechanicsSolver<dim>::bond_updates_per_second_per_core() const
   {
-    return stepping_time > 0. ? double(disc.n_global_bonds()) * stepped / stepping_time /
+    return stepping_time > 0. ? double(n_global_bonds) * stepped / stepping_time /
                                   Utilities::MPI::n_mpi_processes(mpi_communicator) :
                                 0.;
   }

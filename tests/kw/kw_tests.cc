@@ -55,7 +55,9 @@ namespace
     BondBasedModelParameters mp;
 
     // (1) A tilted triangle.
-    const Point<3> A(1.3, 1.1, 2.2), B(7.7, 2.4, 5.1), C(3.2, 7.9, 6.3);
+    // Vertices chosen so that no bond crosses the plane within 1e-9 of an
+    // edge (a crossing exactly on an edge is decided by round-off).
+    const Point<3> A(1.31, 1.17, 2.23), B(7.73, 2.41, 5.19), C(3.27, 7.93, 6.37);
     {
       BondBasedOperator<3> op(disc, mp);
       op.add_precrack(std::vector<Point<3>>{A, B, C});

@@ -184,7 +184,11 @@ namespace PeriDEAL
     {
       return stepping_time;
     }
-    /** Bond updates per second per MPI rank of the time steps of run(). */
+    /**
+     * Bond updates (bonds of all rows x steps) per second per MPI rank of
+     * the time steps of run(), with this rank's stepping time. Not
+     * collective.
+     */
     double
     bond_updates_per_second_per_core() const;
     /** The rows written to the CSV time series (identical on all ranks). */
@@ -215,6 +219,7 @@ namespace PeriDEAL
     std::unique_ptr<BondBasedOperator<dim>> op;
     std::unique_ptr<VelocityVerlet<dim>>    verlet;
     unsigned int                            total_steps = 0;
+    std::uint64_t                           n_global_bonds = 0;
     /** Per owned node: the prescribed region holding it, or -1. */
     std::vector<int> held_by;
     /** Nodes counted by the crack measurement / the energy circle. */
