@@ -97,10 +97,12 @@ namespace
 
   template <int dim>
   void
-  run_mechanics(ParameterHandler &prm, const unsigned int stop_after)
+  run_mechanics(ParameterHandler &prm, const bool resume, const unsigned int stop_after)
   {
     MechanicsRunParameters<dim> parameters;
     parameters.parse_parameters(prm);
+    if (resume)
+      parameters.resume = true;
     write_used_parameters(prm, parameters.output_directory);
     MechanicsSolver<dim> solver(MPI_COMM_WORLD, parameters);
     solver.setup();
@@ -108,10 +110,17 @@ namespace
     // Both are collective: evaluate them on every rank.
     const double        energy = solver.total_energy();
     const std::uint64_t broken = solver.model().n_broken_bonds();
+    const auto          m      = solver.measure();
     if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
       {
         std::cout << "Final: t = " << solver.integrator().time() << ", total energy = " << energy
                   << ", broken bonds = " << broken << std::endl;
+        if (parameters.measure_crack)
+          std::cout << "Crack: angle " << m.crack_angle << " deg (" << m.n_crack_nodes
+                    << " nodes), length " << m.crack_length << std::endl;
+        std::cout << "Stepping: " << solver.stepping_wall_time() << " s wall, "
+                  << solver.bond_updates_per_second_per_core()
+                  << " bond updates per second per core" << std::endl;
         const std::string dir = parameters.output_directory;
         const std::string csv = "'" + dir + "/time_series.csv'";
         run_gnuplot(dir + "/plot.gp",
@@ -136,10 +145,7 @@ namespace
       }
     if (prm.get("Problem") == "mechanics")
       {
-        check_parameter(!resume, "command line", "--resume",
-                        "no --resume for Problem = mechanics (checkpoints are not "
-                        "implemented for it yet)");
-        run_mechanics<dim>(prm, stop_after);
+        run_mechanics<dim>(prm, resume, stop_after);
         return;
       }
     DiffusionRunParameters<dim> parameters;

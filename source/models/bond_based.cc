@@ -538,6 +538,75 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  void
+  BondBasedOperator<dim>::add_precrack(const std::vector<Point<dim>> &polygon)
+  {
+    if constexpr (dim == 2)
+      {
+        check_parameter(polygon.size() == 2, "Pre-crack", polygon.size(),
+                        "2 vertices (a segment) in 2D");
+        add_precrack(polygon[0], polygon[1]);
+      }
+    else if constexpr (dim == 3)
+      {
+        check_parameter(polygon.size() >= 3, "Pre-crack", polygon.size(),
+                        "at least 3 vertices of a planar polygon in 3D");
+        // Newell's normal (robust for non-convex polygons) and the size.
+        Tensor<1, 3> n;
+        double       size = 0.;
+        for (std::size_t k = 0; k < polygon.size(); ++k)
+          {
+            const Point<3> &p = polygon[k], &q = polygon[(k + 1) % polygon.size()];
+            n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+            n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+            n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+            size = std::max(size, p.distance(polygon[0]));
+          }
+        check_parameter(n.norm() > 1e-12 * size * size, "Pre-crack", "a degenerate polygon",
+                        "a polygon of non-zero area");
+        n /= n.norm();
+        const Point<3> &o = polygon[0];
+        for (const auto &p : polygon)
+          check_parameter(std::abs(n * (p - o)) <= 1e-10 * size, "Pre-crack",
+                          "a non-planar polygon", "the vertices of a planar polygon");
+        // In-plane coordinates: drop the dominant normal component.
+        unsigned int drop = 0;
+        for (unsigned int d = 1; d < 3; ++d)
+          if (std::abs(n[d]) > std::abs(n[drop]))
+            drop = d;
+        const unsigned int a0 = (drop + 1) % 3, a1 = (drop + 2) % 3;
+        const auto inside = [&](const Point<3> &x) {
+          bool in = false;
+          for (std::size_t k = 0, l = polygon.size() - 1; k < polygon.size(); l = k++)
+            {
+              const Point<3> &p = polygon[k], &q = polygon[l];
+              if ((p[a1] > x[a1]) != (q[a1] > x[a1]) &&
+                  x[a0] < (q[a0] - p[a0]) * (x[a1] - p[a1]) / (q[a1] - p[a1]) + p[a0])
+                in = !in;
+            }
+          return in;
+        };
+        break_bonds([&](const Point<3> &p, const Point<3> &q) {
+          const double sp = n * (p - o), sq = n * (q - o);
+          if (!(sp * sq < 0.))
+            return false;
+          return inside(p + sp / (sp - sq) * (q - p));
+        });
+      }
+    else
+      throw ParameterError("Pre-crack", "a polygon in 1D", "segments in 2D, polygons in 3D");
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::set_broken_flags(const std::vector<std::uint8_t> &flags)
+  {
+    AssertThrow(flags.size() == broken_flag.size(),
+                ExcMessage("One broken flag per bond of the owned rows is needed."));
+    broken_flag = flags;
+  }
+
+  template <int dim>
   std::uint64_t
   BondBasedOperator<dim>::n_broken_bonds() const
   {

@@ -3,12 +3,19 @@
 
 #include <perideal/base/exceptions.h>
 #include <perideal/base/expressions.h>
+#include <perideal/io/checkpoint.h>
 #include <perideal/io/node_output.h>
 #include <perideal/io/time_series.h>
 #include <perideal/time_stepping/mechanics_solver.h>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
+#include <sstream>
 
 namespace PeriDEAL
 {
@@ -34,6 +41,78 @@ namespace PeriDEAL
         }
       return f;
     }
+    // {f <= 0} of an unbounded level set, evaluated at the owned nodes.
+    template <int dim>
+    std::vector<bool>
+    region_mask(const Discretization<dim> &disc, const std::string &level_set)
+    {
+      Point<dim> lo, hi;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          lo[d] = -std::numeric_limits<double>::max();
+          hi[d] = std::numeric_limits<double>::max();
+        }
+      const LevelSetDomain<dim> set(level_set, lo, hi);
+      std::vector<bool>         mask(disc.n_owned());
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        mask[i] = set.inside(disc.position[i]);
+      return mask;
+    }
+
+    // The first dim of the ';'-separated expressions (extra ones are ignored,
+    // so that one parameter file serves every dimension).
+    template <int dim>
+    std::string
+    first_dim(const std::string &text)
+    {
+      auto parts = Utilities::split_string_list(text, ';');
+      if (parts.size() > dim)
+        parts.resize(dim);
+      std::string joined;
+      for (unsigned int d = 0; d < parts.size(); ++d)
+        joined += (d ? ";" : "") + parts[d];
+      return joined;
+    }
+
+    std::vector<double>
+    numbers(const std::string &text)
+    {
+      try
+        {
+          return Utilities::string_to_double(Utilities::split_string_list(text, ','));
+        }
+      catch (...)
+        {
+          return {};
+        }
+    }
+
+    // Items "LEVEL SET : EXPRESSIONS[ : THICKNESS]" separated by '|'.
+    template <int dim>
+    std::vector<typename MechanicsRunParameters<dim>::Region>
+    parse_regions(const std::string &text, const std::string &parameter, const bool with_thickness)
+    {
+      std::vector<typename MechanicsRunParameters<dim>::Region> regions;
+      const std::string format = with_thickness ? "items 'LEVEL SET : TX; TY[; TZ] : THICKNESS' separated by '|'" :
+                                                  "items 'LEVEL SET : VX; VY[; VZ]' separated by '|'";
+      for (const auto &item : Utilities::split_string_list(text, '|'))
+        {
+          const auto parts = Utilities::split_string_list(item, ':');
+          check_parameter(parts.size() == (with_thickness ? 3u : 2u), parameter, item, format);
+          typename MechanicsRunParameters<dim>::Region r;
+          r.level_set = parts[0];
+          r.value     = first_dim<dim>(parts[1]);
+          if (with_thickness)
+            {
+              const auto h = numbers(parts[2]);
+              check_parameter(h.size() == 1 && h[0] > 0., parameter, item,
+                              format + " with a positive layer thickness");
+              r.thickness = h[0];
+            }
+          regions.push_back(r);
+        }
+      return regions;
+    }
   } // namespace
 
   template <int dim>
@@ -54,12 +133,40 @@ namespace PeriDEAL
     prm.declare_entry("Body force", "0; 0; 0", Patterns::Anything(),
                       "Body force density b of (2.20), 'dim' expressions separated by ';'.");
     prm.declare_entry("Prescribed velocities", "", Patterns::Anything(),
-                      "Node sets moving with a prescribed velocity: items "
+                      "Node sets moving with a prescribed constant velocity: items "
                       "'LEVEL SET : VX; VY[; VZ]' separated by '|'; the set is "
                       "{LEVEL SET <= 0}; later items override earlier ones.");
+    prm.declare_entry("Prescribed displacements", "", Patterns::Anything(),
+                      "Node sets with a prescribed displacement u(x, t): items "
+                      "'LEVEL SET : UX; UY[; UZ]' (expressions in x, y, z, t) separated by "
+                      "'|'; they override prescribed velocities on shared nodes. Their "
+                      "reaction forces follow those of the velocity sets in the CSV.");
+    prm.declare_entry("Tractions", "", Patterns::Anything(),
+                      "Surface tractions T (force per area) applied as the body force "
+                      "T / h on the nodes of a layer of thickness h (Sect. 2.2): items "
+                      "'LEVEL SET : TX; TY[; TZ] : h' separated by '|' (expressions in x, y, z).");
     prm.declare_entry("Pre-cracks", "", Patterns::Anything(),
-                      "2D: segments 'x0, y0, x1, y1' separated by ';'; bonds crossing "
-                      "them are broken before the first step.");
+                      "2D: segments 'x0, y0, x1, y1'; 3D: planar polygons 'x0, y0, z0, x1, "
+                      "y1, z1, x2, y2, z2[, ...]'; separated by ';'. Bonds crossing them are "
+                      "broken before the first step.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Measurements");
+    prm.declare_entry("Crack origin", "", Patterns::Anything(),
+                      "Crack measurement (2D/3D, in the x-y plane): the point the crack "
+                      "grows from (a pre-crack tip), 'x, y[, z]'; empty: off.");
+    prm.declare_entry("Crack region", "", Patterns::Anything(),
+                      "Level set: only nodes with f(x, y, z) <= 0 belong to the measured "
+                      "crack path; empty: all nodes.");
+    prm.declare_entry("Damage threshold", "0.35", Patterns::Double(),
+                      "Nodes of the crack region with damage (2.36) >= this value (in (0, 1]) "
+                      "are crack nodes.");
+    prm.declare_entry("Crack fit radii", "0, 1e300", Patterns::Anything(),
+                      "'r_min, r_max': crack nodes at this distance from the origin enter the "
+                      "total-least-squares line whose angle to the x axis is the crack angle.");
+    prm.declare_entry("Energy circle", "", Patterns::Anything(),
+                      "'x, y[, z], R': kinetic + strain energy of the nodes within R of the "
+                      "center go to the CSV; empty: off.");
     prm.leave_subsection();
   }
 
@@ -82,46 +189,59 @@ namespace PeriDEAL
     p.enter_subsection("Mechanics");
     density = p.get_double("Density");
     check_parameter(density > 0., "Mechanics/Density", density, "a positive number");
-    auto first_dim = [](const std::string &text) {
-      auto parts = Utilities::split_string_list(text, ';');
-      if (parts.size() > dim)
-        parts.resize(dim);
-      std::string joined;
-      for (unsigned int d = 0; d < parts.size(); ++d)
-        joined += (d ? ";" : "") + parts[d];
-      return joined;
-    };
-    initial_velocity = first_dim(p.get("Initial velocity"));
-    body_force       = first_dim(p.get("Body force"));
-    prescribed_velocities.clear();
-    for (const auto &item : Utilities::split_string_list(p.get("Prescribed velocities"), '|'))
-      {
-        const auto colon = item.find(':');
-        check_parameter(colon != std::string::npos, "Mechanics/Prescribed velocities", item,
-                        "items 'LEVEL SET : VX; VY[; VZ]' separated by '|'");
-        prescribed_velocities.emplace_back(item.substr(0, colon),
-                                           first_dim(item.substr(colon + 1)));
-      }
+    initial_velocity = first_dim<dim>(p.get("Initial velocity"));
+    body_force       = first_dim<dim>(p.get("Body force"));
+    prescribed_velocities =
+      parse_regions<dim>(p.get("Prescribed velocities"), "Mechanics/Prescribed velocities", false);
+    prescribed_displacements = parse_regions<dim>(p.get("Prescribed displacements"),
+                                                  "Mechanics/Prescribed displacements", false);
+    tractions = parse_regions<dim>(p.get("Tractions"), "Mechanics/Tractions", true);
     precracks.clear();
     for (const auto &item : Utilities::split_string_list(p.get("Pre-cracks"), ';'))
       {
-        std::vector<double> v;
-        try
-          {
-            v = Utilities::string_to_double(Utilities::split_string_list(item, ','));
-          }
-        catch (...)
-          {
-          }
-        check_parameter(dim == 2 && v.size() == 4, "Mechanics/Pre-cracks", item,
-                        "2D segments 'x0, y0, x1, y1' separated by ';'");
-        Point<dim> a, b;
+        const auto v = numbers(item);
+        check_parameter((dim == 2 && v.size() == 4) ||
+                          (dim == 3 && v.size() >= 9 && v.size() % 3 == 0),
+                        "Mechanics/Pre-cracks", item,
+                        "2D segments 'x0, y0, x1, y1' or 3D polygons of at least 3 "
+                        "vertices 'x0, y0, z0, x1, y1, z1, ...', separated by ';'");
+        std::vector<Point<dim>> polygon(v.size() / dim);
+        for (unsigned int k = 0; k < polygon.size(); ++k)
+          for (unsigned int d = 0; d < dim; ++d)
+            polygon[k][d] = v[k * dim + d];
+        precracks.push_back(polygon);
+      }
+    p.leave_subsection();
+
+    p.enter_subsection("Measurements");
+    const std::string origin = p.get("Crack origin");
+    measure_crack            = !origin.empty();
+    if (measure_crack)
+      {
+        check_parameter(dim >= 2, "Measurements/Crack origin", origin,
+                        "empty in 1D (the crack angle is measured in the x-y plane)");
+        crack_origin = parse_point<dim>(origin, "Measurements/Crack origin");
+      }
+    crack_region     = p.get("Crack region");
+    damage_threshold = p.get_double("Damage threshold");
+    check_parameter(damage_threshold > 0. && damage_threshold <= 1.,
+                    "Measurements/Damage threshold", damage_threshold, "a number in (0, 1]");
+    const auto radii = numbers(p.get("Crack fit radii"));
+    check_parameter(radii.size() == 2 && radii[0] >= 0. && radii[1] > radii[0],
+                    "Measurements/Crack fit radii", p.get("Crack fit radii"),
+                    "'r_min, r_max' with 0 <= r_min < r_max");
+    crack_fit_min_radius = radii[0];
+    crack_fit_max_radius = radii[1];
+    const std::string circle = p.get("Energy circle");
+    energy_radius            = 0.;
+    if (!circle.empty())
+      {
+        const auto v = numbers(circle);
+        check_parameter(v.size() == dim + 1 && v[dim] > 0., "Measurements/Energy circle", circle,
+                        "'x, y[, z], R' with dim coordinates and R > 0");
         for (unsigned int d = 0; d < dim; ++d)
-          {
-            a[d] = v[d];
-            b[d] = v[2 + d];
-          }
-        precracks.emplace_back(a, b);
+          energy_center[d] = v[d];
+        energy_radius = v[dim];
       }
     p.leave_subsection();
 
@@ -137,6 +257,9 @@ namespace PeriDEAL
     output_directory     = p.get("Directory");
     snapshot_interval    = p.get_integer("Snapshot interval");
     time_series_interval = p.get_integer("Time series interval");
+    checkpoint_interval  = p.get_integer("Checkpoint interval");
+    resume               = p.get_bool("Resume");
+    write_node_table     = p.get_bool("Write node table");
     progress_interval    = p.get_double("Progress interval");
     p.leave_subsection();
   }
@@ -163,9 +286,10 @@ namespace PeriDEAL
   MechanicsSolver<dim>::setup()
   {
     disc.setup(*prm.domain, prm.lattice);
-    op = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
+    n_global_bonds = disc.n_global_bonds();
+    op             = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
     for (const auto &crack : prm.precracks)
-      op->add_precrack(crack.first, crack.second);
+      op->add_precrack(crack);
 
     const double dt_critical = op->critical_time_step(prm.density);
     double       dt          = prm.time_step;
@@ -182,26 +306,328 @@ namespace PeriDEAL
           verlet->velocity[d].local_element(i)   = v0->value(disc.position[i], d);
           verlet->body_force[d].local_element(i) = b->value(disc.position[i], d);
         }
-    for (const auto &[region, velocity] : prm.prescribed_velocities)
+    // Tractions: T / h on the nodes of the layer, so that sum b V = T x area.
+    for (const auto &r : prm.tractions)
       {
-        // An unbounded level set: the region is {f <= 0}.
-        Point<dim> lo, hi;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            lo[d] = -std::numeric_limits<double>::max();
-            hi[d] = std::numeric_limits<double>::max();
-          }
-        const LevelSetDomain<dim> set(region, lo, hi);
-        const auto        v = vector_function<dim>(velocity, "Mechanics/Prescribed velocities");
-        std::vector<bool> mask(disc.n_owned());
+        const auto mask = region_mask(disc, r.level_set);
+        const auto T    = vector_function<dim>(r.value, "Mechanics/Tractions");
         for (unsigned int i = 0; i < disc.n_owned(); ++i)
-          mask[i] = set.inside(disc.position[i]);
+          if (mask[i])
+            for (unsigned int d = 0; d < dim; ++d)
+              verlet->body_force[d].local_element(i) += T->value(disc.position[i], d) / r.thickness;
+      }
+
+    held_by.assign(disc.n_owned(), -1);
+    int k = 0;
+    for (const auto &r : prm.prescribed_velocities)
+      {
+        const auto mask = region_mask(disc, r.level_set);
+        const auto v    = vector_function<dim>(r.value, "Mechanics/Prescribed velocities");
         Tensor<1, dim> value;
         for (unsigned int d = 0; d < dim; ++d)
           value[d] = v->value(Point<dim>(), d);
         verlet->add_prescribed_velocity(mask, value);
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (mask[i])
+            held_by[i] = k;
+        ++k;
       }
+    for (const auto &r : prm.prescribed_displacements)
+      {
+        const auto mask = region_mask(disc, r.level_set);
+        std::shared_ptr<FunctionParser<dim>> u =
+          vector_function<dim>(r.value, "Mechanics/Prescribed displacements");
+        verlet->add_prescribed_displacement(mask, [u](const Point<dim> &x, const double t) {
+          u->set_time(t);
+          Tensor<1, dim> value;
+          for (unsigned int d = 0; d < dim; ++d)
+            value[d] = u->value(x, d);
+          return value;
+        });
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (mask[i])
+            held_by[i] = k;
+        ++k;
+      }
+
+    in_crack_region.assign(disc.n_owned(), prm.measure_crack);
+    if (prm.measure_crack && !prm.crack_region.empty())
+      in_crack_region = region_mask(disc, prm.crack_region);
+    in_energy_circle.assign(disc.n_owned(), false);
+    if (prm.energy_radius > 0.)
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        in_energy_circle[i] = disc.position[i].distance(prm.energy_center) <= prm.energy_radius;
     verlet->initialize();
+  }
+
+  template <int dim>
+  MechanicsMeasurements
+  MechanicsSolver<dim>::measure() const
+  {
+    Vector damage, W;
+    disc.initialize_vector(damage);
+    disc.initialize_vector(W);
+    op->damage(damage);
+    op->strain_energy_density(verlet->displacement, W);
+
+    // Local sums: 0 kinetic, 1 strain, 2 circle kinetic, 3 circle strain,
+    // 4..9 the weighted moments w, wx, wy, wxx, wxy, wyy of the fit, 10 count.
+    double                 s[11] = {};
+    double                 length = 0., max_damage = 0.;
+    const double           rho = prm.density;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double V  = disc.volume[i];
+        double       v2 = 0.;
+        for (unsigned int d = 0; d < dim; ++d)
+          v2 += verlet->velocity[d].local_element(i) * verlet->velocity[d].local_element(i);
+        const double ek = 0.5 * rho * v2 * V, es = W.local_element(i) * V;
+        s[0] += ek;
+        s[1] += es;
+        if (in_energy_circle[i])
+          {
+            s[2] += ek;
+            s[3] += es;
+          }
+        const double phi = damage.local_element(i);
+        max_damage       = std::max(max_damage, phi);
+        if (!in_crack_region[i] || phi < prm.damage_threshold)
+          continue;
+        const double r = disc.position[i].distance(prm.crack_origin);
+        length         = std::max(length, r);
+        if (r < prm.crack_fit_min_radius || r > prm.crack_fit_max_radius)
+          continue;
+        const double x = disc.position[i][0] - prm.crack_origin[0],
+                     y = dim > 1 ? disc.position[i][dim > 1 ? 1 : 0] - prm.crack_origin[dim > 1 ? 1 : 0] : 0.;
+        s[4] += V;
+        s[5] += V * x;
+        s[6] += V * y;
+        s[7] += V * x * x;
+        s[8] += V * x * y;
+        s[9] += V * y * y;
+        s[10] += 1.;
+      }
+    Utilities::MPI::sum(s, mpi_communicator, s);
+
+    MechanicsMeasurements m;
+    m.kinetic_energy        = s[0];
+    m.strain_energy         = s[1];
+    m.circle_kinetic_energy = s[2];
+    m.circle_strain_energy  = s[3];
+    m.crack_length          = Utilities::MPI::max(length, mpi_communicator);
+    m.max_damage            = Utilities::MPI::max(max_damage, mpi_communicator);
+    m.n_crack_nodes         = (unsigned long)s[10];
+    m.crack_angle           = std::numeric_limits<double>::quiet_NaN();
+    if (m.n_crack_nodes >= 3)
+      {
+        // Principal axis of the covariance: the total-least-squares line.
+        const double w = s[4], mx = s[5] / w, my = s[6] / w;
+        const double cxx = s[7] / w - mx * mx, cxy = s[8] / w - mx * my, cyy = s[9] / w - my * my;
+        double       angle = 0.5 * std::atan2(2. * cxy, cxx - cyy) * 180. / M_PI;
+        if (angle < 0.)
+          angle += 180.;
+        m.crack_angle = angle;
+      }
+    return m;
+  }
+
+  template <int dim>
+  Tensor<1, dim>
+  MechanicsSolver<dim>::reaction_force(const unsigned int k) const
+  {
+    Tensor<1, dim> R;
+    const auto    &F = verlet->internal_force();
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (held_by[i] == int(k))
+        for (unsigned int d = 0; d < dim; ++d)
+          R[d] -= (F[d].local_element(i) + verlet->body_force[d].local_element(i)) * disc.volume[i];
+    return Utilities::MPI::sum(R, mpi_communicator);
+  }
+
+  template <int dim>
+  double
+  MechanicsSolver<dim>::bond_updates_per_second_per_core() const
+  {
+    return stepping_time > 0. ? double(n_global_bonds) * stepped / stepping_time /
+                                  Utilities::MPI::n_mpi_processes(mpi_communicator) :
+                                0.;
+  }
+
+  template <int dim>
+  std::vector<std::string>
+  MechanicsSolver<dim>::time_series_columns() const
+  {
+    std::vector<std::string> c = {"time", "kinetic_energy", "strain_energy", "total_energy",
+                                  "broken_bonds", "max_damage"};
+    const char *xyz[3] = {"x", "y", "z"};
+    for (unsigned int k = 0; k < n_prescribed_regions(); ++k)
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back("reaction_" + std::to_string(k + 1) + "_" + xyz[d]);
+    if (prm.measure_crack)
+      for (const char *name : {"crack_angle", "crack_nodes", "crack_length", "crack_speed"})
+        c.push_back(name);
+    if (prm.energy_radius > 0.)
+      for (const char *name : {"circle_kinetic_energy", "circle_strain_energy", "circle_energy"})
+        c.push_back(name);
+    c.push_back("wall_time");
+    return c;
+  }
+
+  template <int dim>
+  std::string
+  MechanicsSolver<dim>::signature() const
+  {
+    std::ostringstream s;
+    s.precision(16);
+    s << "mechanics " << dim << " " << disc.n_global() << " " << prm.lattice.dx << " "
+      << prm.lattice.delta << " " << verlet->time_step() << " " << op->micromodulus() << " "
+      << op->critical_stretch();
+    return s.str();
+  }
+
+  namespace
+  {
+    // The broken bonds as (id_i, id_j) pairs of the owned rows, next to the
+    // node checkpoint; both carry the step, which must agree on reading.
+    const std::string bonds_magic = "PERIDEAL-BROKEN-BONDS-1";
+  }
+
+  template <int dim>
+  void
+  MechanicsSolver<dim>::write_checkpoint() const
+  {
+    const auto &nb = disc.neighborhood;
+    const auto &br = op->broken();
+    std::vector<std::uint64_t> pairs;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+        if (br[b])
+          {
+            pairs.push_back(disc.id[i]);
+            pairs.push_back(disc.id[nb.col[b]]);
+          }
+    const auto all = Utilities::MPI::gather(mpi_communicator, pairs, 0);
+    const std::string dir = prm.output_directory;
+    internal::run_on_root(mpi_communicator, [&]() {
+      std::vector<std::uint64_t> merged;
+      for (const auto &p : all)
+        merged.insert(merged.end(), p.begin(), p.end());
+      std::string bytes = bonds_magic;
+      const std::uint64_t header[2] = {verlet->step(), merged.size()};
+      bytes.append(reinterpret_cast<const char *>(header), sizeof(header));
+      bytes.append(reinterpret_cast<const char *>(merged.data()), merged.size() * sizeof(std::uint64_t));
+      write_file_atomically(dir + "/checkpoint_bonds.bin", bytes);
+    });
+    std::vector<const Vector *> fields;
+    for (unsigned int d = 0; d < dim; ++d)
+      fields.push_back(&verlet->displacement[d]);
+    for (unsigned int d = 0; d < dim; ++d)
+      fields.push_back(&verlet->velocity[d]);
+    PeriDEAL::write_checkpoint<dim>(dir + "/checkpoint.bin", disc, verlet->step(), verlet->time(),
+                                    fields, signature());
+  }
+
+  template <int dim>
+  bool
+  MechanicsSolver<dim>::read_checkpoint()
+  {
+    std::vector<Vector *> fields;
+    for (unsigned int d = 0; d < dim; ++d)
+      fields.push_back(&verlet->displacement[d]);
+    for (unsigned int d = 0; d < dim; ++d)
+      fields.push_back(&verlet->velocity[d]);
+    unsigned int step = 0;
+    double       time = 0.;
+    const std::string dir = prm.output_directory;
+    if (!PeriDEAL::read_checkpoint<dim>(dir + "/checkpoint.bin", disc, step, time, fields, signature()))
+      return false;
+
+    std::vector<std::uint64_t> pairs;
+    std::uint64_t              bond_step = 0;
+    internal::run_on_root(mpi_communicator, [&]() {
+      std::ifstream in(dir + "/checkpoint_bonds.bin", std::ios::binary);
+      std::string   magic(bonds_magic.size(), ' ');
+      std::uint64_t header[2] = {0, 0};
+      in.read(magic.data(), magic.size());
+      in.read(reinterpret_cast<char *>(header), sizeof(header));
+      if (!in || magic != bonds_magic)
+        throw std::runtime_error("Checkpoint '" + dir + "/checkpoint_bonds.bin' is missing or malformed.");
+      pairs.resize(header[1]);
+      in.read(reinterpret_cast<char *>(pairs.data()), pairs.size() * sizeof(std::uint64_t));
+      if (!in || header[1] % 2 != 0)
+        throw std::runtime_error("Checkpoint '" + dir + "/checkpoint_bonds.bin' is truncated.");
+      bond_step = header[0];
+    });
+    pairs     = Utilities::MPI::broadcast(mpi_communicator, pairs, 0);
+    bond_step = Utilities::MPI::broadcast(mpi_communicator, bond_step, 0);
+    if (bond_step != step)
+      throw std::runtime_error("Checkpoint files in '" + dir + "' belong to different steps (" +
+                               std::to_string(step) + " and " + std::to_string(bond_step) + ").");
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> broken(pairs.size() / 2);
+    for (std::size_t k = 0; k < broken.size(); ++k)
+      broken[k] = {pairs[2 * k], pairs[2 * k + 1]};
+    std::sort(broken.begin(), broken.end());
+    const auto           &nb = disc.neighborhood;
+    std::vector<std::uint8_t> flags(nb.n_bonds(), 0);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+        flags[b] = std::binary_search(broken.begin(), broken.end(),
+                                      std::pair<std::uint64_t, std::uint64_t>(disc.id[i], disc.id[nb.col[b]]));
+    op->set_broken_flags(flags);
+    for (auto &u : verlet->displacement)
+      u.update_ghost_values();
+    verlet->restart(step, time);
+    return true;
+  }
+
+  template <int dim>
+  void
+  MechanicsSolver<dim>::record(const bool snapshot)
+  {
+    const MechanicsMeasurements m   = measure();
+    std::vector<double>         row = {verlet->time(), m.kinetic_energy, m.strain_energy,
+                                       m.kinetic_energy + m.strain_energy,
+                                       double(op->n_broken_bonds()), m.max_damage};
+    for (unsigned int k = 0; k < n_prescribed_regions(); ++k)
+      {
+        const auto R = reaction_force(k);
+        for (unsigned int d = 0; d < dim; ++d)
+          row.push_back(R[d]);
+      }
+    if (prm.measure_crack)
+      {
+        // Tip speed: growth of the crack length since the previous row.
+        const unsigned int col   = 6 + dim * n_prescribed_regions() + 2;
+        double             speed = 0.;
+        if (!series_rows.empty() && verlet->time() > series_rows.back()[0])
+          speed = (m.crack_length - series_rows.back()[col]) /
+                  (verlet->time() - series_rows.back()[0]);
+        row.insert(row.end(), {m.crack_angle, double(m.n_crack_nodes), m.crack_length, speed});
+      }
+    if (prm.energy_radius > 0.)
+      row.insert(row.end(), {m.circle_kinetic_energy, m.circle_strain_energy,
+                             m.circle_kinetic_energy + m.circle_strain_energy});
+    row.push_back(wall_offset + wall.wall_time());
+    csv->add_row(row);
+    series_rows.push_back(row);
+    if (snapshot)
+      {
+        Vector damage;
+        disc.initialize_vector(damage);
+        op->damage(damage);
+        std::vector<std::pair<std::string, const Vector *>> fields;
+        const char *names[3]  = {"u_x", "u_y", "u_z"};
+        const char *vnames[3] = {"v_x", "v_y", "v_z"};
+        for (unsigned int d = 0; d < dim; ++d)
+          fields.emplace_back(names[d], &verlet->displacement[d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          fields.emplace_back(vnames[d], &verlet->velocity[d]);
+        fields.emplace_back("damage", &damage);
+        if (snapshot)
+          vtu->write(verlet->time(), verlet->step(), fields);
+        if (prm.write_node_table && verlet->step() == total_steps)
+          PeriDEAL::write_node_table<dim>(prm.output_directory + "/nodes.csv", disc, fields);
+      }
   }
 
   template <int dim>
@@ -211,57 +637,58 @@ namespace PeriDEAL
     ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(mpi_communicator) == 0);
     if (!op)
       setup();
-    NodeOutput<dim> vtu(disc, prm.output_directory, "solution");
-    TimeSeries      csv(mpi_communicator, prm.output_directory + "/time_series.csv",
-                   {"time", "kinetic_energy", "strain_energy", "total_energy", "broken_bonds",
-                    "max_damage"});
-    Vector damage, speed;
-    disc.initialize_vector(damage);
-    disc.initialize_vector(speed);
+    if (!csv)
+      {
+        internal::run_on_root(mpi_communicator, [&]() {
+          std::filesystem::create_directories(prm.output_directory);
+        });
+        vtu = std::make_unique<NodeOutput<dim>>(disc, prm.output_directory, "solution");
+        csv = std::make_unique<TimeSeries>(mpi_communicator,
+                                           prm.output_directory + "/time_series.csv",
+                                           time_series_columns());
+        wall.restart();
+        const bool resumed = prm.resume && read_checkpoint();
+        if (resumed)
+          {
+            csv->load_existing();
+            csv->truncate_after(verlet->time() * (1. + 1e-12));
+            vtu->restart(verlet->time());
+            series_rows = csv->rows();
+            wall_offset = series_rows.empty() ? 0. : series_rows.back().back();
+            pcout << "Resumed from checkpoint at step " << verlet->step()
+                  << ", t = " << verlet->time() << std::endl;
+          }
+        pcout << "Bond-based PD in " << dim << "D: " << disc.n_global() << " nodes, "
+              << disc.n_global_bonds() << " bonds, c = " << op->micromodulus()
+              << ", s0 = " << op->critical_stretch() << ", dt = " << verlet->time_step()
+              << " (critical " << verlet->critical_time_step() << "), " << total_steps
+              << " steps" << std::endl;
+        if (!resumed)
+          record(true);
+      }
 
-    pcout << "Bond-based PD in " << dim << "D: " << disc.n_global() << " nodes, "
-          << disc.n_global_bonds() << " bonds, c = " << op->micromodulus()
-          << ", s0 = " << op->critical_stretch() << ", dt = " << verlet->time_step()
-          << " (critical " << verlet->critical_time_step() << "), " << total_steps << " steps"
-          << std::endl;
-
-    auto record = [&](const bool snapshot) {
-      op->damage(damage);
-      const double ek = verlet->kinetic_energy(), es = verlet->strain_energy();
-      csv.add_row({verlet->time(), ek, es, ek + es, double(op->n_broken_bonds()),
-                   damage.linfty_norm()});
-      if (snapshot)
-        {
-          std::vector<std::pair<std::string, const Vector *>> fields;
-          const char *names[3] = {"u_x", "u_y", "u_z"};
-          const char *vnames[3] = {"v_x", "v_y", "v_z"};
-          for (unsigned int d = 0; d < dim; ++d)
-            fields.emplace_back(names[d], &verlet->displacement[d]);
-          for (unsigned int d = 0; d < dim; ++d)
-            fields.emplace_back(vnames[d], &verlet->velocity[d]);
-          fields.emplace_back("damage", &damage);
-          vtu.write(verlet->time(), verlet->step(), fields);
-        }
-    };
-    record(true);
-    Timer        wall;
-    double       last_progress = 0.;
-    unsigned int done          = 0;
+    unsigned int done = 0;
     while (verlet->step() < total_steps && done < max_steps)
       {
+        const auto start = std::chrono::steady_clock::now();
         verlet->advance();
+        stepping_time +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        ++stepped;
         ++done;
         const bool last = verlet->step() == total_steps;
         const bool snap = last || (prm.snapshot_interval > 0 &&
                                    verlet->step() % prm.snapshot_interval == 0);
-        if (snap || last || verlet->step() % prm.time_series_interval == 0)
+        if (snap || verlet->step() % prm.time_series_interval == 0)
           record(snap);
+        if (prm.checkpoint_interval > 0 && verlet->step() % prm.checkpoint_interval == 0)
+          write_checkpoint();
         if (wall.wall_time() - last_progress >= prm.progress_interval && !last)
           {
             last_progress = wall.wall_time();
             pcout << "  step " << verlet->step() << "/" << total_steps << "  elapsed "
                   << std::fixed << std::setprecision(1) << last_progress << " s  remaining ~"
-                  << last_progress / done * (total_steps - verlet->step()) << " s"
+                  << stepping_time / stepped * (total_steps - verlet->step()) << " s"
                   << std::defaultfloat << std::setprecision(6) << std::endl;
           }
       }

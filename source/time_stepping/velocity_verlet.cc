@@ -20,6 +20,7 @@ namespace PeriDEAL
     for (VectorField *f : {&displacement, &velocity, &acceleration, &body_force, &force})
       model.initialize(*f);
     prescribed_set.assign(disc.n_owned(), -1);
+    displacement_set.assign(disc.n_owned(), -1);
   }
 
   template <int dim>
@@ -31,7 +32,48 @@ namespace PeriDEAL
     prescribed_values.push_back(v);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (mask[i])
-        prescribed_set[i] = prescribed_values.size() - 1;
+        {
+          prescribed_set[i]   = prescribed_values.size() - 1;
+          displacement_set[i] = -1;
+        }
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::add_prescribed_displacement(
+    const std::vector<bool>                                                &mask,
+    const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &u)
+  {
+    AssertThrow(mask.size() >= disc.n_owned(), ExcMessage("The mask must cover the owned nodes."));
+    prescribed_displacements.push_back(u);
+    displacement_nodes.clear();
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        if (mask[i])
+          {
+            displacement_set[i] = prescribed_displacements.size() - 1;
+            prescribed_set[i]   = -1;
+          }
+        if (displacement_set[i] >= 0)
+          displacement_nodes.push_back(i);
+      }
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::apply_prescribed_displacements(const double time, const bool set_velocity)
+  {
+    for (const unsigned int i : displacement_nodes)
+      {
+        if (displacement_set[i] < 0) // overridden by a later velocity set
+          continue;
+        const Tensor<1, dim> value = prescribed_displacements[displacement_set[i]](disc.position[i], time);
+        for (unsigned int d = 0; d < dim; ++d)
+          if (set_velocity) // before the update: v = (u(t) - u^n) / dt
+            velocity[d].local_element(i) = (value[d] - displacement[d].local_element(i)) / dt;
+          else // after it: exactly u(t), without the round-off of u^n + dt v
+            displacement[d].local_element(i) = value[d];
+      }
   }
 
   template <int dim>
@@ -55,7 +97,7 @@ namespace PeriDEAL
     for (unsigned int d = 0; d < dim; ++d)
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         acceleration[d].local_element(i) =
-          prescribed_set[i] >= 0 ?
+          (prescribed_set[i] >= 0 || displacement_set[i] >= 0) ?
             0. :
             inv_rho * (force[d].local_element(i) + body_force[d].local_element(i));
   }
@@ -65,6 +107,16 @@ namespace PeriDEAL
   VelocityVerlet<dim>::initialize()
   {
     apply_prescribed_velocities();
+    apply_prescribed_displacements(t, false);
+    update_accelerations();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::restart(const unsigned int step, const double time)
+  {
+    n_steps = step;
+    t       = time;
     update_accelerations();
   }
 
@@ -73,6 +125,9 @@ namespace PeriDEAL
   VelocityVerlet<dim>::advance()
   {
     const unsigned int n = disc.n_owned();
+    // Held nodes: u^{n+1} from the prescribed function, v = du/dt by the
+    // difference quotient (set first: it needs u^n).
+    apply_prescribed_displacements(t + dt, true);
     for (unsigned int d = 0; d < dim; ++d)
       {
         double       *u = displacement[d].begin();
@@ -84,6 +139,7 @@ namespace PeriDEAL
             u[i] += dt * v[i];
           }
       }
+    apply_prescribed_displacements(t + dt, false);
     update_accelerations();
     for (unsigned int d = 0; d < dim; ++d)
       {

@@ -49,3 +49,25 @@ perideal_add_test(NAME driver.mechanics NPROCS 2 COMMAND ${_perideal} ${_d}/crac
   LABELS "unit;mpi" TIMEOUT 300)
 set_tests_properties(driver.mechanics PROPERTIES
   PASS_REGULAR_EXPRESSION "Final: t = 300, total energy = [0-9.e-]+, broken bonds = [1-9][0-9]*")
+
+# Checkpoint/restart of a mechanics run with fracture: uninterrupted
+# reference on 1 rank, a run stopped after 137 steps (last checkpoint at 100)
+# and resumed on 2 ranks; u, v and damage of all nodes must agree.
+perideal_add_test(NAME driver.mechanics_restart.reference
+  COMMAND ${_perideal} ${_d}/mechanics_restart.prm
+  LABELS unit FIXTURES_SETUP mech_restart_ref
+  WORKING_DIRECTORY ${CMAKE_BINARY_DIR}/tests/run/mech_restart_ref)
+perideal_add_test(NAME driver.mechanics_restart.interrupted
+  COMMAND ${_perideal} --stop-after-steps 137 ${_d}/mechanics_restart.prm
+  LABELS unit FIXTURES_SETUP mech_restart_int
+  WORKING_DIRECTORY ${CMAKE_BINARY_DIR}/tests/run/mech_restart_int)
+perideal_add_test(NAME driver.mechanics_restart.resumed NPROCS 2
+  COMMAND ${_perideal} --resume ${_d}/mechanics_restart.prm
+  LABELS "unit;mpi" FIXTURES_SETUP mech_restart_res FIXTURES_REQUIRED mech_restart_int
+  WORKING_DIRECTORY ${CMAKE_BINARY_DIR}/tests/run/mech_restart_int)
+# Same arithmetic per bond on any rank count (see mechanics.rank_invariance):
+# round-off only.
+perideal_add_test(NAME driver.mechanics_restart.compare
+  COMMAND ${_perideal} --compare ${CMAKE_BINARY_DIR}/tests/run/mech_restart_ref/output/nodes.csv
+          ${CMAKE_BINARY_DIR}/tests/run/mech_restart_int/output/nodes.csv 1e-12
+  LABELS unit FIXTURES_REQUIRED "mech_restart_ref;mech_restart_res")

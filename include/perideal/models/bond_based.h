@@ -194,6 +194,24 @@ namespace PeriDEAL
     void
     add_precrack(const Point<dim> &a, const Point<dim> &b);
 
+    /**
+     * Pre-crack along a planar polygon (3D, at least 3 vertices in order)
+     * or a segment (2D, 2 vertices): break the bonds whose segment x_i x_j
+     * crosses the polygon's plane strictly (end points on opposite sides)
+     * at a point inside the polygon (crossing-number test in the plane).
+     * Throws ParameterError ('Pre-crack') for a degenerate or non-planar
+     * polygon or in 1D.
+     */
+    void
+    add_precrack(const std::vector<Point<dim>> &polygon);
+
+    /**
+     * Replace the broken flags of the owned rows (one per CSR bond, e.g.
+     * restored from a checkpoint). Both copies of a bond must agree.
+     */
+    void
+    set_broken_flags(const std::vector<std::uint8_t> &flags);
+
     /** Broken flag (1 broken) per CSR bond of the owned rows. */
     const std::vector<std::uint8_t> &
     broken() const

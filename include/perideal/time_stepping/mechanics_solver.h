@@ -3,40 +3,77 @@
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/timer.h>
 
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/domain.h>
 #include <perideal/models/bond_based.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace PeriDEAL
 {
+  template <int dim>
+  class NodeOutput;
+  class TimeSeries;
+
   /**
    * Everything an explicit bond-based PD run reads from its parameter file:
    * geometry and discretization (shared with the diffusion runs), the
    * bond-based model (Model/Bond-based), density, initial velocity, body
-   * force, prescribed-velocity regions and pre-cracks (Mechanics), time
-   * stepping and output.
+   * force, prescribed-velocity and prescribed-displacement regions,
+   * tractions and pre-cracks (Mechanics), the measurements taken from the
+   * damage and energy fields (Measurements), time stepping and output.
    */
   template <int dim>
   struct MechanicsRunParameters
   {
+    /** A node set {level set <= 0} with dim expressions "f1; f2[; f3]". */
+    struct Region
+    {
+      std::string level_set, value;
+      /** Layer thickness of a traction (0 otherwise). */
+      double thickness = 0.;
+    };
+
     std::shared_ptr<Domain<dim>> domain;
     LatticeParameters            lattice;
     BondBasedModelParameters     model;
     double                       density = 1.;
     std::string                  initial_velocity, body_force;
-    /** (region level set {f <= 0}, velocity expressions "vx; vy[; vz]") */
-    std::vector<std::pair<std::string, std::string>> prescribed_velocities;
+    /** Constant velocities (expressions in x, y, z). */
+    std::vector<Region> prescribed_velocities;
+    /** Displacements u(x, t) (expressions in x, y, z, t). */
+    std::vector<Region> prescribed_displacements;
+    /** Tractions T (force per area), applied as the body force T / h in a layer of thickness h. */
+    std::vector<Region> tractions;
     /** 2D pre-crack segments (a, b). */
-    std::vector<std::pair<Point<dim>, Point<dim>>> precracks;
+    std::vector<std::vector<Point<dim>>> precracks;
+
+    /** @name Measurements */
+    /** @{ */
+    /** Crack measurement on if true: origin (pre-crack tip) of the crack path. */
+    bool        measure_crack = false;
+    Point<dim>  crack_origin;
+    /** Nodes considered for the crack path: {level set <= 0}; empty: all. */
+    std::string crack_region;
+    double      damage_threshold = 0.35;
+    /** Nodes within [r_min, r_max] of the origin enter the angle fit. */
+    double      crack_fit_min_radius = 0., crack_fit_max_radius = std::numeric_limits<double>::max();
+    /** Energy circle (ball) center and radius; radius 0: off. */
+    Point<dim>  energy_center;
+    double      energy_radius = 0.;
+    /** @} */
+
     double       time_step = 0., end_time = 1.;
     std::string  output_directory = "output";
-    unsigned int snapshot_interval = 0, time_series_interval = 1;
+    unsigned int snapshot_interval = 0, time_series_interval = 1, checkpoint_interval = 0;
+    bool         resume           = false;
+    bool         write_node_table = false;
     double       progress_interval = 10.;
 
     /** Declare the mechanics entries (Geometry etc. are declared elsewhere). */
@@ -48,11 +85,40 @@ namespace PeriDEAL
   };
 
   /**
+   * What MechanicsSolver measures from the damage, displacement and
+   * velocity fields at one time (all global, identical on every rank).
+   */
+  struct MechanicsMeasurements
+  {
+    /**
+     * Angle (degrees, in [0, 180)) to the x axis of the total-least-squares
+     * line through the nodes of the crack region with damage >= threshold
+     * at distance [r_min, r_max] from the crack origin (volume weighted);
+     * NaN with fewer than 3 such nodes.
+     */
+    double crack_angle = 0.;
+    /** Number of nodes in that fit. */
+    unsigned long n_crack_nodes = 0;
+    /** Largest distance from the origin of a node of the crack region with damage >= threshold. */
+    double crack_length = 0.;
+    /** Kinetic and strain energy of the nodes in the energy circle. */
+    double circle_kinetic_energy = 0., circle_strain_energy = 0.;
+    /** Kinetic and strain energy of the whole body. */
+    double kinetic_energy = 0., strain_energy = 0.;
+    /** Largest damage. */
+    double max_damage = 0.;
+  };
+
+  /**
    * Dynamic bond-based PD (PMB/GPBM with brittle fracture, or linearized)
    * with velocity Verlet: the run behind `perideal` with
    * `Problem = mechanics`. Writes displacement, velocity and damage to
-   * VTU and kinetic/strain energy, broken bonds and maximum damage to the
-   * CSV time series.
+   * VTU and to the CSV time series: kinetic/strain energy, broken bonds,
+   * maximum damage, the reaction force of every prescribed region, the
+   * crack measurements (angle, length, tip speed), the energy in a circle
+   * and the wall time. Checkpoints (displacement and velocity keyed by node
+   * id, broken bonds keyed by the ids of their end points) restart on any
+   * number of ranks.
    */
   template <int dim>
   class MechanicsSolver
@@ -65,7 +131,12 @@ namespace PeriDEAL
     void
     setup();
 
-    /** March to the end time (at most @p max_steps steps of this call). */
+    /**
+     * March to the end time (at most @p max_steps steps of this call; calls
+     * continue where the last one stopped). The first call resumes from
+     * the checkpoint if asked to, creates the output directory and records
+     * the initial state.
+     */
     void
     run(const unsigned int max_steps = std::numeric_limits<unsigned int>::max());
 
@@ -89,15 +160,78 @@ namespace PeriDEAL
     /** Kinetic + strain energy. */
     double
     total_energy() const;
+    /** The measurements at the current time. Collective. */
+    MechanicsMeasurements
+    measure() const;
+    /**
+     * Reaction force of prescribed region @p k (velocity regions first, then
+     * displacement regions): the force the supports exert on the body,
+     * -sum_i (F_i + b_i) V_i over the nodes held by region k. The inertia
+     * of the held nodes is not included (zero for constant velocities).
+     * Collective.
+     */
+    Tensor<1, dim>
+    reaction_force(const unsigned int k) const;
+    /** Number of prescribed regions. */
+    unsigned int
+    n_prescribed_regions() const
+    {
+      return prm.prescribed_velocities.size() + prm.prescribed_displacements.size();
+    }
+    /** Wall time of the time steps of run() (without output). */
+    double
+    stepping_wall_time() const
+    {
+      return stepping_time;
+    }
+    /**
+     * Bond updates (bonds of all rows x steps) per second per MPI rank of
+     * the time steps of run(), with this rank's stepping time. Not
+     * collective.
+     */
+    double
+    bond_updates_per_second_per_core() const;
+    /** The rows written to the CSV time series (identical on all ranks). */
+    const std::vector<std::vector<double>> &
+    time_series() const
+    {
+      return series_rows;
+    }
+    /** The CSV column names. */
+    std::vector<std::string>
+    time_series_columns() const;
     /** @} */
 
   private:
+    std::string
+    signature() const;
+    void
+    write_checkpoint() const;
+    bool
+    read_checkpoint();
+    /** Add a CSV row (and a VTU snapshot if @p snapshot). */
+    void
+    record(const bool snapshot);
+
     MPI_Comm                                mpi_communicator;
     MechanicsRunParameters<dim>             prm;
     Discretization<dim>                     disc;
     std::unique_ptr<BondBasedOperator<dim>> op;
     std::unique_ptr<VelocityVerlet<dim>>    verlet;
     unsigned int                            total_steps = 0;
+    std::uint64_t                           n_global_bonds = 0;
+    /** Per owned node: the prescribed region holding it, or -1. */
+    std::vector<int> held_by;
+    /** Nodes counted by the crack measurement / the energy circle. */
+    std::vector<bool> in_crack_region, in_energy_circle;
+    double            stepping_time = 0.;
+    unsigned int      stepped       = 0;
+    std::vector<std::vector<double>> series_rows;
+    /** Output, created by the first run(). */
+    std::unique_ptr<NodeOutput<dim>> vtu;
+    std::unique_ptr<TimeSeries>      csv;
+    Timer                            wall;
+    double                           wall_offset = 0., last_progress = 0.;
   };
 } // namespace PeriDEAL
 

@@ -5,6 +5,7 @@
 
 #include <perideal/models/bond_based.h>
 
+#include <functional>
 #include <vector>
 
 namespace PeriDEAL
@@ -42,6 +43,32 @@ namespace PeriDEAL
      */
     void
     add_prescribed_velocity(const std::vector<bool> &mask, const Tensor<1, dim> &v);
+
+    /**
+     * Nodes i < n_owned() with @p mask[i] true follow the displacement
+     * @p u(x, t) from now on: after each step u_i = u(x_i, t^{n+1}) and
+     * v_i = (u_i^{n+1} - u_i^n) / dt (a later set, of either kind, overrides
+     * an earlier one on shared nodes).
+     */
+    void
+    add_prescribed_displacement(
+      const std::vector<bool>                                                &mask,
+      const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &u);
+
+    /** The internal force density F (owned entries) of the last evaluation. */
+    const VectorField &
+    internal_force() const
+    {
+      return force;
+    }
+
+    /**
+     * Continue from a state read from a checkpoint: set the step counter and
+     * time, refresh the displacement ghosts and recompute a from u (the
+     * broken flags of the model must have been restored first).
+     */
+    void
+    restart(const unsigned int step, const double time);
 
     /**
      * Apply the prescribed velocities and compute a^0 from the current
@@ -104,6 +131,14 @@ namespace PeriDEAL
     /** Per owned node: index into prescribed_values, or -1. */
     std::vector<int>            prescribed_set;
     std::vector<Tensor<1, dim>> prescribed_values;
+    /** Per owned node: index into prescribed_displacements, or -1. */
+    std::vector<int> displacement_set;
+    std::vector<std::function<Tensor<1, dim>(const Point<dim> &, const double)>>
+      prescribed_displacements;
+    /** Owned nodes with a prescribed displacement. */
+    std::vector<unsigned int> displacement_nodes;
+    void
+    apply_prescribed_displacements(const double time, const bool set_velocity);
   };
 } // namespace PeriDEAL
 
