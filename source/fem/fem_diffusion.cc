@@ -216,18 +216,34 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::energy(const BoundingBox<dim> &region) const
     {
-      const QGauss<dim>   quadrature(fe.degree + 2);
-      FEValues<dim>       fe_values(fe, quadrature, update_values | update_JxW_values);
-      std::vector<double> values(quadrature.size());
-      double              e = 0.;
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (region.point_inside(cell->center(), 1e-10))
-          {
-            fe_values.reinit(cell);
-            fe_values.get_function_values(C, values);
-            for (unsigned int q = 0; q < quadrature.size(); ++q)
-              e += values[q] * values[q] * fe_values.JxW(q);
-          }
+      // integral of C_h^2 = sum over cells of C_c^T M_c C_c; the cell mass
+      // matrices of the region are computed once.
+      if (energy_dofs.empty() || energy_region.get_boundary_points() != region.get_boundary_points())
+        {
+          energy_region = region;
+          energy_dofs.clear();
+          energy_mass.clear();
+          const QGauss<dim> quadrature(fe.degree + 1);
+          FEValues<dim>     fe_values(fe, quadrature, update_values | update_JxW_values);
+          for (const auto &cell : dof_handler.active_cell_iterators())
+            if (region.point_inside(cell->center(), 1e-10))
+              {
+                fe_values.reinit(cell);
+                FullMatrix<double> m(fe.n_dofs_per_cell(), fe.n_dofs_per_cell());
+                for (unsigned int q = 0; q < quadrature.size(); ++q)
+                  for (unsigned int i = 0; i < m.m(); ++i)
+                    for (unsigned int j = 0; j < m.n(); ++j)
+                      m(i, j) += fe_values.shape_value(i, q) * fe_values.shape_value(j, q) * fe_values.JxW(q);
+                energy_dofs.emplace_back(fe.n_dofs_per_cell());
+                cell->get_dof_indices(energy_dofs.back());
+                energy_mass.push_back(m);
+              }
+        }
+      double e = 0.;
+      for (unsigned int c = 0; c < energy_dofs.size(); ++c)
+        for (unsigned int i = 0; i < energy_dofs[c].size(); ++i)
+          for (unsigned int j = 0; j < energy_dofs[c].size(); ++j)
+            e += C[energy_dofs[c][i]] * energy_mass[c](i, j) * C[energy_dofs[c][j]];
       return e;
     }
 

@@ -10,6 +10,7 @@
 
 #include <deal.II/grid/tria.h>
 
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
@@ -114,6 +115,10 @@ namespace PeriDEAL
       bool                      use_solver = false;
       Abc::EbfDiffusionAbc<dim> abc;
       std::vector<double>       boundary_values;
+      /** energy(): cells of the last region, their DoFs and local mass matrices. */
+      mutable BoundingBox<dim>                                  energy_region;
+      mutable std::vector<std::vector<types::global_dof_index>> energy_dofs;
+      mutable std::vector<FullMatrix<double>>                   energy_mass;
       dealii::Vector<double>            C, rhs, tmp;
       double                    t = 0.;
     };
