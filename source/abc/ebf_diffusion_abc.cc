@@ -25,7 +25,7 @@ namespace PeriDEAL
       prm.declare_entry("Number of directions", "5", Patterns::Integer(1, 50),
                         "n_phi: mode directions in [0, pi/2] per angle (2D/3D).");
       prm.declare_entry("Wave number range", "0", Patterns::Double(0.),
-                        "Delta k; 0 selects 1/(8 d_inf). Must satisfy (4.33) D Delta k^2 dt < 1.");
+                        "Delta k; 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D. Must satisfy (4.33) D Delta k^2 dt < 1.");
       prm.declare_entry("Cloud radius", "0.25", Patterns::Double(0.), "d_inf.");
       prm.declare_entry("Dispersion relation", "local", Patterns::Selection("local|nonlocal"),
                         "local (4.9) or nonlocal PD (4.13).");
@@ -198,11 +198,13 @@ namespace PeriDEAL
       // Delta k and its bound (4.33): D Delta k^2 dt < 1.
       const double D     = dispersion.diffusivity();
       const double bound = 1. / std::sqrt(D * dt);
-      // Default Delta k = 1 / (8 d_inf): the source does not report its Delta k;
-      // this is the best of the study Delta k in {0.1, 0.25, 0.5, 1, 2, 4} at
-      // d_inf = 0.25 (tutorial step-5, doc.md): larger values over-absorb,
-      // smaller ones make the modes nearly collinear.
-      const double dk = prm.wave_number_range > 0 ? prm.wave_number_range : 0.125 / prm.cloud_radius;
+      // Default Delta k: the source does not report its Delta k. These are
+      // the best values of scans on the Gaussian problems (d_inf = 0.25):
+      // 1D Delta k in {0.1, 0.25, 0.5, 1, 2, 4} -> 0.5 = 1/(8 d_inf); 2D
+      // {0.5, 2, 4, 8, 12, 16} -> 8 = 2/d_inf (<= 2 unstable, >= 12
+      // over-absorbing); see tutorial/step-5/doc.md.
+      const double dk = prm.wave_number_range > 0 ? prm.wave_number_range :
+                                                    (dim == 1 ? 0.125 : 2.) / prm.cloud_radius;
       check_parameter(dk < bound, "Absorbing boundary/Wave number range", dk,
                       "0 < Delta k < 1/sqrt(D dt) = " + std::to_string(bound) + " (4.33)");
       stats.wave_number_range = dk;

@@ -41,8 +41,9 @@ namespace PeriDEAL
       const double delta    = lattice.delta;
       const double layer    = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
       const double h        = 1e-3 * lattice.dx;
-      check_parameter(prm.cloud_radius <= delta + 1e-12 * delta, "Absorbing boundary/Cloud radius",
-                      prm.cloud_radius, "<= the horizon (clouds must lie within the ghost layer)");
+      // The ghost layer holds every node within delta + dx/2 of an owned node.
+      check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
+                      prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
       check_parameter(layer >= lattice.dx - 1e-12 * lattice.dx, "Absorbing boundary/Layer thickness",
                       layer, ">= dx (at least one node layer)");
 

@@ -250,7 +250,8 @@ namespace Step5
     std::ostringstream gp;
     gp << gnuplot_png_preamble(p.output_directory + "/energy_difference.png")
        << "set datafile separator ','\nset key autotitle columnhead outside right\n"
-       << "set logscale y\nset format y '10^{%L}'\nset xlabel 't'\nset ylabel '{/Symbol D}{/Symbol P}/{/Symbol P}_0'\n"
+       << "set logscale y\nset yrange [1e-7:1]\nset xlabel 't'\n"
+       << "set ylabel 'normalized energy difference |Pi - Pi_ref| / Pi_ref(0)'\n"
        << "plot for [i=2:" << fem.size() + pd.size() - 1 << "] '" << p.output_directory
        << "/energy_difference.csv' using 1:i with lines lw 2\n";
     run_gnuplot(p.output_directory + "/energy_difference.gp", gp.str(),

@@ -35,7 +35,7 @@ namespace PeriDEAL
       /** n_phi: directions phi_l equally spaced in [0, pi/2] (2D), or per
        * spherical angle (3D). Ignored in 1D. */
       unsigned int n_directions = 5;
-      /** Delta k of (4.25); 0 selects 1/(8 d_inf) (see the .cc). */
+      /** Delta k of (4.25); 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D (empirical, see the .cc). */
       double wave_number_range = 0.;
       /** Cloud radius d_inf. */
       double cloud_radius = 0.25;
