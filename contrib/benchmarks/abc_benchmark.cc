@@ -1,0 +1,95 @@
+// Overhead of the EBF absorbing boundary (one dot product per absorbing
+// node and step) as a fraction of the whole explicit step, for PD and FEM
+// near fields in 1D and 2D. Prints `key: value` lines:
+//   abc_overhead_fraction_{pd,fem}_{1d,2d}
+// Sizes: 2D PD box (-4,4)^2, dx = 1/16, delta = 4 dx (16,641 nodes,
+// 1,984 absorbing); 2D FEM Q1 lumped on (-4,4)^2 with 256^2 cells;
+// 1D: (-30,30) at dx = 0.125 as in step-5. Usage: abc_benchmark [steps].
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/mpi.h>
+
+#include <deal.II/grid/grid_generator.h>
+
+#include <perideal/abc/pd_unbounded_diffusion.h>
+#include <perideal/fem/fem_diffusion.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+using namespace dealii;
+using namespace PeriDEAL;
+
+template <int dim>
+class Gaussian : public Function<dim>
+{
+public:
+  double
+  value(const Point<dim> &p, const unsigned int = 0) const override
+  {
+    return std::exp(-4. * p.square());
+  }
+};
+
+template <int dim>
+double
+pd_fraction(const double L, const double dx, const unsigned int steps)
+{
+  Point<dim> lo, hi;
+  for (unsigned int d = 0; d < dim; ++d)
+    lo[d] = -L, hi[d] = L;
+  BoxDomain<dim>    box(lo, hi);
+  LatticeParameters lp;
+  lp.dx    = dx;
+  lp.delta = 4. * dx;
+  DiffusionModelParameters model;
+  model.exponent = 1.;
+  Abc::EbfParameters ap;
+  ap.cloud_radius = 0.5 * lp.delta * (1. + 1e-9);
+  Abc::PdUnboundedDiffusion<dim> run(MPI_COMM_WORLD);
+  const double dt = 0.5 * dx * dx / (2. * dim);
+  run.setup(box, lp, model, dt, Abc::TruncationBoundary::absorbing, ap, Gaussian<dim>());
+  for (unsigned int n = 0; n < steps; ++n)
+    run.advance();
+  return Utilities::MPI::sum(run.abc_seconds, MPI_COMM_WORLD) /
+         Utilities::MPI::sum(run.step_seconds, MPI_COMM_WORLD);
+}
+
+template <int dim>
+double
+fem_fraction(const double L, const unsigned int cells, const unsigned int steps)
+{
+  Triangulation<dim> tria;
+  GridGenerator::subdivided_hyper_cube(tria, cells, -L, L);
+  const double                dx = 2. * L / cells;
+  Fem::FemDiffusionParameters fp;
+  fp.time_step = 0.5 * dx * dx / (2. * dim);
+  Abc::EbfParameters ap;
+  ap.cloud_radius = 2. * dx * (1. + 1e-9);
+  Fem::FemDiffusion<dim> run(tria, fp);
+  run.setup(Abc::TruncationBoundary::absorbing, ap, Gaussian<dim>());
+  for (unsigned int n = 0; n < steps; ++n)
+    run.advance();
+  return run.abc_seconds / run.step_seconds;
+}
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const unsigned int steps = argc > 1 ? std::atoi(argv[1]) : 2000;
+  const double pd2 = pd_fraction<2>(4., 1. / 16., steps);
+  const double pd1 = pd_fraction<1>(30., 0.125, 20 * steps);
+  double fem2 = 0., fem1 = 0.;
+  if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+    {
+      fem2 = fem_fraction<2>(4., 256, steps);
+      fem1 = fem_fraction<1>(30., 480, 20 * steps);
+      std::cout << "abc_overhead_fraction_pd_2d: " << pd2 << "\n"
+                << "abc_overhead_fraction_pd_1d: " << pd1 << "\n"
+                << "abc_overhead_fraction_fem_2d: " << fem2 << "\n"
+                << "abc_overhead_fraction_fem_1d: " << fem1 << std::endl;
+    }
+  return 0;
+}

@@ -1,0 +1,198 @@
+#ifndef perideal_abc_ebf_diffusion_abc_h
+#define perideal_abc_ebf_diffusion_abc_h
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/base/types.h>
+
+#include <perideal/base/kernel.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  using namespace dealii;
+
+  /**
+   * Absorbing boundary conditions from exponential basis functions (EBFs)
+   * for diffusion-type problems on unbounded domains (dissertation
+   * Sect. 4.1, paper 002). Shared by every near field (PD and deal.II FEM).
+   */
+  namespace Abc
+  {
+    /**
+     * Parameters of the EBF absorbing boundary ("Absorbing boundary"
+     * subsection).
+     */
+    struct EbfParameters
+    {
+      /** n_k: wave numbers k_m = -m Delta k / n_k, m = 1..n_k (4.25). */
+      unsigned int n_wave_numbers = 20;
+      /** n_phi: directions phi_l equally spaced in [0, pi/2] (2D), or per
+       * spherical angle (3D). Ignored in 1D. */
+      unsigned int n_directions = 5;
+      /** Delta k of (4.25); 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D (empirical, see the .cc). */
+      double wave_number_range = 0.;
+      /** Cloud radius d_inf. */
+      double cloud_radius = 0.25;
+      /** "local" (4.9) or "nonlocal" (4.13)/(4.15), the latter by quadrature. */
+      std::string dispersion = "local";
+      /** PD absorbing layer thickness delta_L (0: the horizon). */
+      double layer_thickness = 0.;
+      /** Stability guard: largest admissible moment-matrix condition number. */
+      double max_condition_number = 1e12;
+      /** Stability guard: largest admissible max-norm of an updating vector. */
+      double max_update_norm = 2.;
+
+      static void
+      declare_parameters(ParameterHandler &prm);
+      /** The caller has entered "Absorbing boundary". */
+      void
+      parse_parameters(ParameterHandler &prm);
+    };
+
+    /**
+     * Dispersion relation omega(k) of the real far-field modes
+     * psi = exp(k n.x + omega t): local omega = D k^2 (4.9), or the nonlocal
+     * PD relation (4.13) omega = integral over the horizon of
+     * J(|xi|) (exp(k n.xi) - 1), which is isotropic, so that the angular
+     * integral is closed-form (1D: 2 (cosh(kr) - 1), 2D: 2 pi (I_0(kr) - 1),
+     * 3D: 4 pi (sinh(kr)/(kr) - 1)) and only the radial one is done by
+     * Gauss quadrature.
+     */
+    class DiffusionDispersion
+    {
+    public:
+      /** omega = D k^2. */
+      static DiffusionDispersion
+      local(const double diffusivity);
+      /** The PD relation of @p kernel (its constant is kappa). */
+      static DiffusionDispersion
+      nonlocal(const ScalarKernel &kernel);
+
+      /** omega(k). */
+      double
+      operator()(const double k) const
+      {
+        return omega(k);
+      }
+      /** The local diffusivity the relation tends to as k -> 0. */
+      double
+      diffusivity() const
+      {
+        return local_diffusivity;
+      }
+      /** "local" or "nonlocal". */
+      std::string name;
+
+    private:
+      std::function<double(double)> omega;
+      double                        local_diffusivity = 1.;
+    };
+
+    /** Summary of the clouds after setup (global over all ranks). */
+    struct CloudStatistics
+    {
+      types::global_dof_index n_absorbing = 0;
+      unsigned int            min_cloud_size = 0, max_cloud_size = 0;
+      /** Largest condition number (sigma_max / smallest retained sigma) of M_G. */
+      double max_condition_number = 0.;
+      /** Largest max-norm of an updating vector V. */
+      double max_update_norm = 0.;
+      /** Largest sum_j |V_j| (the amplification bound of one update). */
+      double max_update_l1 = 0.;
+      /** Delta k used and the bound (4.33) 1/sqrt(D dt). */
+      double wave_number_range = 0., wave_number_bound = 0.;
+    };
+
+    /**
+     * The EBF absorbing boundary for diffusion: for every absorbing node x_i
+     * (owned by this rank) a cloud of the available points within d_inf
+     * (x_i first, then by global id, so that the result does not depend on
+     * the partition), a local frame rotated so that the first
+     * quadrant/octant faces the exterior (4.24), the real mode set obeying
+     * the infinity condition (4.22), the moment matrix M_G (4.28), its
+     * Moore-Penrose inverse (Eigen complete orthogonal decomposition) and
+     * the updating vector V = Psi(0, dt) M_G^+ (4.31). Per step the new
+     * absorbing value is one dot product V . G^n.
+     */
+    template <int dim>
+    class EbfDiffusionAbc
+    {
+    public:
+      /**
+       * Precompute everything. @p points / @p ids: every point available on
+       * this rank (owned and ghost, in the local numbering of the field
+       * vectors) with its global id. @p absorbing: local indices of the owned
+       * absorbing points, @p outward_normals their outward normals.
+       * Throws ParameterError if Delta k violates (4.33) or a cloud is
+       * unusable (too few points, condition number or |V| above the guards).
+       */
+      void
+      reinit(const std::vector<Point<dim>>              &points,
+             const std::vector<types::global_dof_index> &ids,
+             const std::vector<unsigned int>            &absorbing,
+             const std::vector<Tensor<1, dim>>          &outward_normals,
+             const DiffusionDispersion                  &dispersion,
+             const double                                time_step,
+             const EbfParameters                        &parameters,
+             const MPI_Comm                              comm);
+
+      /**
+       * values[a] = V_a . G^n for absorbing node a, from the point values
+       * @p u (local numbering, ghosts included and up to date).
+       */
+      void
+      compute(const double *u, std::vector<double> &values) const
+      {
+        values.resize(absorbing.size());
+        for (unsigned int a = 0; a < absorbing.size(); ++a)
+          {
+            double s = 0.;
+            for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+              s += update_vector[c] * u[cloud_index[c]];
+            values[a] = s;
+          }
+      }
+
+      /** Local indices of the owned absorbing points. */
+      const std::vector<unsigned int> &
+      absorbing_points() const
+      {
+        return absorbing;
+      }
+      /** Cloud (local indices) and updating vector of absorbing point a. */
+      std::vector<std::pair<unsigned int, double>>
+      cloud(const unsigned int a) const;
+      /** Statistics of all clouds. */
+      const CloudStatistics &
+      statistics() const
+      {
+        return stats;
+      }
+
+      /**
+       * The local frame R with R n = (1,..,1)/sqrt(dim) (4.24 in 2D; 1D: the
+       * outward axis; 3D: the first octant faces the exterior).
+       */
+      static Tensor<2, dim>
+      local_frame(const Tensor<1, dim> &outward_normal);
+      /** Unit direction vectors of the modes in the local frame (4.22). */
+      static std::vector<Tensor<1, dim>>
+      mode_directions(const unsigned int n_directions);
+
+    private:
+      std::vector<unsigned int> absorbing;
+      std::vector<unsigned int> cloud_start;
+      std::vector<unsigned int> cloud_index;
+      std::vector<double>       update_vector;
+      CloudStatistics           stats;
+    };
+  } // namespace Abc
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,100 @@
+#ifndef perideal_abc_pd_unbounded_diffusion_h
+#define perideal_abc_pd_unbounded_diffusion_h
+
+#include <deal.II/base/bounding_box.h>
+#include <deal.II/base/function.h>
+
+#include <perideal/abc/ebf_diffusion_abc.h>
+#include <perideal/discretization/discretization.h>
+#include <perideal/models/diffusion.h>
+
+#include <memory>
+
+namespace PeriDEAL
+{
+  namespace Abc
+  {
+    /** How the truncation boundary of a near field is treated. */
+    enum class TruncationBoundary
+    {
+      /** The EBF absorbing boundary (Dirichlet values from the clouds). */
+      absorbing,
+      /** Nothing: homogeneous Neumann (free PD surface / natural FEM BC). */
+      neumann
+    };
+
+    /**
+     * PD diffusion near field on a truncated domain, marched with explicit
+     * forward Euler (3.4) through the DiffusionOperator, with the EBF
+     * absorbing boundary on the nodes within delta_L of the truncation
+     * boundary (dissertation Sect. 4.1.2, 002 Algorithm 1). The domain must
+     * have a signed distance (box, ball). Works on any number of ranks:
+     * clouds use the node partitioner's ghosts (d_inf <= delta is required,
+     * which every ghost layer covers).
+     */
+    template <int dim>
+    class PdUnboundedDiffusion
+    {
+    public:
+      PdUnboundedDiffusion(const MPI_Comm comm);
+
+      /**
+       * Build the lattice, the operator and (for @p boundary absorbing) the
+       * clouds; set C = @p initial. @p time_step must satisfy the operator's
+       * Gershgorin bound.
+       */
+      void
+      setup(const Domain<dim>              &domain,
+            const LatticeParameters        &lattice,
+            const DiffusionModelParameters &model,
+            const double                    time_step,
+            const TruncationBoundary        boundary,
+            const EbfParameters            &abc,
+            const Function<dim>            &initial);
+
+      /** One forward Euler step with the absorbing update. */
+      void
+      advance();
+
+      /** Pi = sum C_i^2 V_i over the nodes inside @p region (all ranks). */
+      double
+      energy(const BoundingBox<dim> &region) const;
+
+      /** Current time. */
+      double
+      time() const
+      {
+        return t;
+      }
+      /** The field (ghosts not necessarily up to date). */
+      const Vector &
+      solution() const
+      {
+        return C;
+      }
+      const Discretization<dim> &
+      discretization() const
+      {
+        return disc;
+      }
+      /** The ABC (empty for Neumann truncation). */
+      const EbfDiffusionAbc<dim> &
+      absorbing_boundary() const
+      {
+        return abc;
+      }
+      /** Wall seconds spent in the ABC update and in the whole of advance(). */
+      double abc_seconds = 0., step_seconds = 0.;
+
+    private:
+      Discretization<dim>                   disc;
+      std::unique_ptr<DiffusionOperator<dim>> op;
+      EbfDiffusionAbc<dim>                  abc;
+      Vector                                C, rate;
+      std::vector<double>                   boundary_values;
+      double                                dt = 0., t = 0.;
+    };
+  } // namespace Abc
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,128 @@
+#ifndef perideal_fem_fem_diffusion_h
+#define perideal_fem_fem_diffusion_h
+
+#include <deal.II/base/bounding_box.h>
+#include <deal.II/base/function.h>
+
+#include <deal.II/dofs/dof_handler.h>
+
+#include <deal.II/fe/fe_q.h>
+
+#include <deal.II/grid/tria.h>
+
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <perideal/abc/ebf_diffusion_abc.h>
+#include <perideal/abc/pd_unbounded_diffusion.h>
+
+#include <string>
+
+namespace PeriDEAL
+{
+  namespace Fem
+  {
+    /** Parameters of the classical FEM diffusion solver. */
+    struct FemDiffusionParameters
+    {
+      /** FE_Q degree (1 or 2). */
+      unsigned int degree = 1;
+      /** Lumped (Gauss-Lobatto, diagonal) or consistent mass matrix. */
+      bool lumped_mass = true;
+      /** "forward Euler" or "backward Euler". */
+      std::string scheme = "forward Euler";
+      /** Diffusivity D of (4.1). */
+      double diffusivity = 1.;
+      /** Time step. */
+      double time_step = 1e-3;
+    };
+
+    /**
+     * Classical diffusion (4.1) C_t = D Laplace C with continuous FE_Q
+     * elements on a serial deal.II triangulation: M dC/dt + K C = 0 (4.32)
+     * marched with forward or backward Euler. The truncation boundary is
+     * either natural (homogeneous Neumann) or absorbing: the boundary DoFs
+     * are the absorbing nodes of the EBF ABC, whose values at t^{n+1}
+     * (computed from the DoF values at t^n) enter the step as
+     * time-dependent Dirichlet rows. Systems are factorized once
+     * (UMFPACK); with lumped mass the explicit step needs no solve.
+     */
+    template <int dim>
+    class FemDiffusion
+    {
+    public:
+      FemDiffusion(const Triangulation<dim> &tria, const FemDiffusionParameters &parameters);
+
+      /**
+       * Distribute DoFs, assemble M and K, build the ABC (for @p boundary
+       * absorbing; local dispersion with D), interpolate @p initial.
+       * Throws ParameterError if the explicit step is unstable.
+       */
+      void
+      setup(const Abc::TruncationBoundary boundary,
+            const Abc::EbfParameters     &abc_parameters,
+            const Function<dim>          &initial);
+
+      /** One time step. */
+      void
+      advance();
+
+      /** Pi = integral of C_h^2 over the cells with centre in @p region. */
+      double
+      energy(const BoundingBox<dim> &region) const;
+
+      /** max over DoFs inside @p region of |C_h - exact(t)|. */
+      double
+      max_error(Function<dim> &exact, const BoundingBox<dim> &region) const;
+
+      double
+      time() const
+      {
+        return t;
+      }
+      const dealii::Vector<double> &
+      solution() const
+      {
+        return C;
+      }
+      const DoFHandler<dim> &
+      get_dof_handler() const
+      {
+        return dof_handler;
+      }
+      const Abc::EbfDiffusionAbc<dim> &
+      absorbing_boundary() const
+      {
+        return abc;
+      }
+      /** Largest stable forward Euler step 2 / lambda_max(M^-1 K) (power iteration). */
+      double critical_time_step = 0.;
+      /** Wall seconds in the ABC update and in advance(). */
+      double abc_seconds = 0., step_seconds = 0.;
+
+    private:
+      const Triangulation<dim> &tria;
+      FemDiffusionParameters    prm;
+      FE_Q<dim>                 fe;
+      DoFHandler<dim>           dof_handler;
+      SparsityPattern           sparsity;
+      SparseMatrix<double>      mass, stiffness, system;
+      dealii::Vector<double>            lumped;
+      SparseDirectUMFPACK       solver;
+      bool                      use_solver = false;
+      Abc::EbfDiffusionAbc<dim> abc;
+      std::vector<double>       boundary_values;
+      /** energy(): cells of the last region, their DoFs and local mass matrices. */
+      mutable BoundingBox<dim>                                  energy_region;
+      mutable std::vector<std::vector<types::global_dof_index>> energy_dofs;
+      mutable std::vector<FullMatrix<double>>                   energy_mass;
+      dealii::Vector<double>            C, rhs, tmp;
+      double                    t = 0.;
+    };
+  } // namespace Fem
+} // namespace PeriDEAL
+
+#endif

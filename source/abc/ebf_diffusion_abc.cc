@@ -1,0 +1,341 @@
+#include <deal.II/base/quadrature_lib.h>
+
+#include <boost/math/special_functions/bessel.hpp>
+
+#include <perideal/abc/ebf_diffusion_abc.h>
+#include <perideal/base/exceptions.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace PeriDEAL
+{
+  namespace Abc
+  {
+    void
+    EbfParameters::declare_parameters(ParameterHandler &prm)
+    {
+      prm.declare_entry("Number of wave numbers", "20", Patterns::Integer(1, 200),
+                        "n_k: wave numbers k_m = -m Delta k / n_k (4.25).");
+      prm.declare_entry("Number of directions", "5", Patterns::Integer(1, 50),
+                        "n_phi: mode directions in [0, pi/2] per angle (2D/3D).");
+      prm.declare_entry("Wave number range", "0", Patterns::Double(0.),
+                        "Delta k; 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D. Must satisfy (4.33) D Delta k^2 dt < 1.");
+      prm.declare_entry("Cloud radius", "0.25", Patterns::Double(0.), "d_inf.");
+      prm.declare_entry("Dispersion relation", "local", Patterns::Selection("local|nonlocal"),
+                        "local (4.9) or nonlocal PD (4.13).");
+      prm.declare_entry("Layer thickness", "0", Patterns::Double(0.),
+                        "PD absorbing layer delta_L (0: the horizon).");
+      prm.declare_entry("Maximum condition number", "1e12", Patterns::Double(1.),
+                        "Guard on the moment matrices.");
+      prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
+                        "Guard on max_j |V_j|.");
+    }
+
+    void
+    EbfParameters::parse_parameters(ParameterHandler &prm)
+    {
+      n_wave_numbers       = prm.get_integer("Number of wave numbers");
+      n_directions         = prm.get_integer("Number of directions");
+      wave_number_range    = prm.get_double("Wave number range");
+      cloud_radius         = prm.get_double("Cloud radius");
+      dispersion           = prm.get("Dispersion relation");
+      layer_thickness      = prm.get_double("Layer thickness");
+      max_condition_number = prm.get_double("Maximum condition number");
+      max_update_norm      = prm.get_double("Maximum updating vector norm");
+      check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
+    }
+
+
+    DiffusionDispersion
+    DiffusionDispersion::local(const double diffusivity)
+    {
+      DiffusionDispersion d;
+      d.name              = "local";
+      d.local_diffusivity = diffusivity;
+      d.omega             = [diffusivity](const double k) { return diffusivity * k * k; };
+      return d;
+    }
+
+    DiffusionDispersion
+    DiffusionDispersion::nonlocal(const ScalarKernel &kernel)
+    {
+      DiffusionDispersion d;
+      d.name              = "nonlocal";
+      d.local_diffusivity = kernel.local_coefficient();
+      // Radial Gauss rule on [0, delta]; the integrand J(r) r^(dim-1) A(kr)
+      // with A(kr) = O((kr)^2) is smooth for integer exponents.
+      const QGauss<1>     gauss(40);
+      std::vector<double> r, w;
+      for (unsigned int q = 0; q < gauss.size(); ++q)
+        {
+          r.push_back(gauss.point(q)[0] * kernel.delta);
+          w.push_back(gauss.weight(q) * kernel.delta);
+        }
+      const unsigned int dim = kernel.dim;
+      d.omega                = [kernel, r, w, dim](const double k) {
+        double s = 0.;
+        for (unsigned int q = 0; q < r.size(); ++q)
+          {
+            const double x = k * r[q];
+            double       angular;
+            // exp(x) - 1 - x summed over directions; small-x series avoids
+            // cancellation.
+            if (dim == 1)
+              angular = std::abs(x) < 1e-3 ? x * x * (1. + x * x / 12.) : 2. * (std::cosh(x) - 1.);
+            else if (dim == 2)
+              angular = std::abs(x) < 1e-3 ? 2. * M_PI * (x * x / 4. + x * x * x * x / 64.) :
+                                             2. * M_PI * (boost::math::cyl_bessel_i(0, x) - 1.);
+            else
+              angular = std::abs(x) < 1e-3 ? 4. * M_PI * (x * x / 6. + x * x * x * x / 120.) :
+                                             4. * M_PI * (std::sinh(x) / x - 1.);
+            s += w[q] * kernel(r[q]) * std::pow(r[q], double(dim) - 1.) * angular;
+          }
+        return s;
+      };
+      return d;
+    }
+
+
+    template <int dim>
+    Tensor<2, dim>
+    EbfDiffusionAbc<dim>::local_frame(const Tensor<1, dim> &n_in)
+    {
+      const Tensor<1, dim> n = n_in / n_in.norm();
+      Tensor<2, dim>       R;
+      if (dim == 1)
+        R[0][0] = n[0] > 0 ? 1. : -1.;
+      else if (dim == 2)
+        {
+          // (4.24) with tau such that R n = (1, 1)/sqrt(2).
+          const double tau = std::atan2(n[1], n[0]) - M_PI / 4.;
+          R[0][0]          = std::cos(tau);
+          R[0][1]          = std::sin(tau);
+          R[1][0]          = -std::sin(tau);
+          R[1][1]          = std::cos(tau);
+        }
+      else
+        {
+          // Householder reflection mapping n onto e = (1,1,1)/sqrt(3): an
+          // orthogonal frame whose first octant faces the exterior.
+          Tensor<1, dim> e;
+          for (unsigned int d = 0; d < dim; ++d)
+            e[d] = 1. / std::sqrt(double(dim));
+          const Tensor<1, dim> v = n - e;
+          for (unsigned int i = 0; i < dim; ++i)
+            R[i][i] = 1.;
+          if (v.norm() > 1e-12)
+            for (unsigned int i = 0; i < dim; ++i)
+              for (unsigned int j = 0; j < dim; ++j)
+                R[i][j] -= 2. * v[i] * v[j] / (v * v);
+        }
+      return R;
+    }
+
+    template <int dim>
+    std::vector<Tensor<1, dim>>
+    EbfDiffusionAbc<dim>::mode_directions(const unsigned int n_directions)
+    {
+      std::vector<Tensor<1, dim>> dirs;
+      const auto angle = [n_directions](const unsigned int l) {
+        return n_directions == 1 ? M_PI / 4. : l * (M_PI / 2.) / (n_directions - 1);
+      };
+      if (dim == 1)
+        {
+          Tensor<1, dim> d;
+          d[0] = 1.;
+          dirs.push_back(d);
+        }
+      else if (dim == 2)
+        for (unsigned int l = 0; l < n_directions; ++l)
+          {
+            Tensor<1, dim> d;
+            d[0] = std::cos(angle(l));
+            d[1] = std::sin(angle(l));
+            dirs.push_back(d);
+          }
+      else
+        for (unsigned int l2 = 0; l2 < n_directions; ++l2)
+          for (unsigned int l1 = 0; l1 < n_directions; ++l1)
+            {
+              // phi_2 = 0 is the pole: one direction only.
+              if (l2 == 0 && n_directions > 1 && l1 > 0)
+                continue;
+              Tensor<1, dim> d;
+              d[0]                  = std::cos(angle(l1)) * std::sin(angle(l2));
+              d[1]                  = std::sin(angle(l1)) * std::sin(angle(l2));
+              d[dim - 1]            = std::cos(angle(l2));
+              dirs.push_back(d);
+            }
+      return dirs;
+    }
+
+
+    template <int dim>
+    void
+    EbfDiffusionAbc<dim>::reinit(const std::vector<Point<dim>>              &points,
+                                 const std::vector<types::global_dof_index> &ids,
+                                 const std::vector<unsigned int>            &absorbing_in,
+                                 const std::vector<Tensor<1, dim>>          &normals,
+                                 const DiffusionDispersion                  &dispersion,
+                                 const double                                dt,
+                                 const EbfParameters                        &prm,
+                                 const MPI_Comm                              comm)
+    {
+      AssertDimension(points.size(), ids.size());
+      AssertDimension(absorbing_in.size(), normals.size());
+      absorbing = absorbing_in;
+      cloud_start.assign(1, 0);
+      cloud_index.clear();
+      update_vector.clear();
+      stats = CloudStatistics();
+
+      // Delta k and its bound (4.33): D Delta k^2 dt < 1.
+      const double D     = dispersion.diffusivity();
+      const double bound = 1. / std::sqrt(D * dt);
+      // Default Delta k: the source does not report its Delta k. These are
+      // the best values of scans on the Gaussian problems (d_inf = 0.25):
+      // 1D Delta k in {0.1, 0.25, 0.5, 1, 2, 4} -> 0.5 = 1/(8 d_inf); 2D
+      // {0.5, 2, 4, 8, 12, 16} -> 8 = 2/d_inf (<= 2 unstable, >= 12
+      // over-absorbing); see tutorial/step-5/doc.md.
+      const double dk = prm.wave_number_range > 0 ? prm.wave_number_range :
+                                                    (dim == 1 ? 0.125 : 2.) / prm.cloud_radius;
+      check_parameter(dk < bound, "Absorbing boundary/Wave number range", dk,
+                      "0 < Delta k < 1/sqrt(D dt) = " + std::to_string(bound) + " (4.33)");
+      stats.wave_number_range = dk;
+      stats.wave_number_bound = bound;
+
+      // Modes: directions (4.22) times negative wave numbers in dk [-1, 0).
+      const auto          dirs = mode_directions(prm.n_directions);
+      std::vector<double> k(prm.n_wave_numbers), growth(prm.n_wave_numbers);
+      for (unsigned int m = 0; m < prm.n_wave_numbers; ++m)
+        {
+          k[m]      = -dk * (m + 1.) / prm.n_wave_numbers;
+          growth[m] = std::exp(dispersion(std::abs(k[m])) * dt);
+        }
+      const unsigned int n_modes = dirs.size() * k.size();
+      Eigen::RowVectorXd psi_dt(n_modes);
+      for (unsigned int l = 0; l < dirs.size(); ++l)
+        for (unsigned int m = 0; m < k.size(); ++m)
+          psi_dt[l * k.size() + m] = growth[m];
+
+      // Bin the points on a grid of width d_inf for the cloud search.
+      const double                               r = prm.cloud_radius;
+      std::map<std::array<long, dim>, std::vector<unsigned int>> bins;
+      const auto                                 bin_of = [r](const Point<dim> &p) {
+        std::array<long, dim> b;
+        for (unsigned int d = 0; d < dim; ++d)
+          b[d] = static_cast<long>(std::floor(p[d] / r));
+        return b;
+      };
+      for (unsigned int i = 0; i < points.size(); ++i)
+        bins[bin_of(points[i])].push_back(i);
+
+      double       max_cond = 0., max_norm = 0., max_l1 = 0.;
+      unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        {
+          const unsigned int i  = absorbing[a];
+          const Point<dim>  &xi = points[i];
+          std::vector<unsigned int> cloud;
+          const auto                b0 = bin_of(xi);
+          const unsigned int        n_neighbour_bins = dim == 1 ? 3 : (dim == 2 ? 9 : 27);
+          for (unsigned int nb = 0; nb < n_neighbour_bins; ++nb)
+            {
+              auto         b = b0;
+              unsigned int c = nb;
+              for (unsigned int d = 0; d < dim; ++d, c /= 3)
+                b[d] += long(c % 3) - 1;
+              const auto it = bins.find(b);
+              if (it != bins.end())
+                for (const unsigned int j : it->second)
+                  if (j != i && xi.distance(points[j]) <= r * (1. + 1e-10))
+                    cloud.push_back(j);
+            }
+          std::sort(cloud.begin(), cloud.end(), [&ids](const unsigned int p, const unsigned int q) {
+            return ids[p] < ids[q];
+          });
+          cloud.insert(cloud.begin(), i);
+
+          std::ostringstream name;
+          name << "cloud of absorbing point " << ids[i] << " at (" << xi << ")";
+          // The source's experience (Sect. 4.1.3): at least 3, 5, 7 points.
+          check_parameter(cloud.size() >= 2 * dim + 1, "Absorbing boundary/Cloud radius", r,
+                          "a radius giving at least " + std::to_string(2 * dim + 1) +
+                            " points per cloud (the " + name.str() + " has " +
+                            std::to_string(cloud.size()) + ")");
+
+          // Moment matrix (4.28) in the rotated frame (4.24).
+          const Tensor<2, dim> R = local_frame(normals[a]);
+          Eigen::MatrixXd      M(cloud.size(), n_modes);
+          for (unsigned int j = 0; j < cloud.size(); ++j)
+            {
+              const Tensor<1, dim> xbar = R * (points[cloud[j]] - xi);
+              for (unsigned int l = 0; l < dirs.size(); ++l)
+                {
+                  const double s = dirs[l] * xbar;
+                  for (unsigned int m = 0; m < k.size(); ++m)
+                    M(j, l * k.size() + m) = std::exp(k[m] * s);
+                }
+            }
+          const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
+          const Eigen::RowVectorXd V = psi_dt * cod.pseudoInverse();
+
+          // Condition number over the retained singular values.
+          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
+          const auto                              &sv   = svd.singularValues();
+          const unsigned int                       rank = cod.rank();
+          const double cond = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
+          const double vmax = V.cwiseAbs().maxCoeff();
+          const double vl1  = V.cwiseAbs().sum();
+          if (!(cond <= prm.max_condition_number) || !(vmax <= prm.max_update_norm))
+            {
+              std::ostringstream v;
+              v << "condition number " << cond << ", max |V_j| " << vmax << " in the " << name.str()
+                << " (" << cloud.size() << " points, " << n_modes << " modes)";
+              throw ParameterError("Absorbing boundary/Wave number range, Cloud radius", v.str(),
+                                   "a mode set with condition number <= " +
+                                     std::to_string(prm.max_condition_number) +
+                                     " and max |V_j| <= " + std::to_string(prm.max_update_norm) +
+                                     " (reduce Delta k, the number of modes or the cloud radius)");
+            }
+          max_cond = std::max(max_cond, cond);
+          max_norm = std::max(max_norm, vmax);
+          max_l1   = std::max(max_l1, vl1);
+          min_size = std::min<unsigned int>(min_size, cloud.size());
+          max_size = std::max<unsigned int>(max_size, cloud.size());
+          for (unsigned int j = 0; j < cloud.size(); ++j)
+            {
+              cloud_index.push_back(cloud[j]);
+              update_vector.push_back(V[j]);
+            }
+          cloud_start.push_back(cloud_index.size());
+        }
+      stats.n_absorbing = Utilities::MPI::sum<types::global_dof_index>(absorbing.size(), comm);
+      stats.max_condition_number = Utilities::MPI::max(max_cond, comm);
+      stats.max_update_norm      = Utilities::MPI::max(max_norm, comm);
+      stats.max_update_l1        = Utilities::MPI::max(max_l1, comm);
+      stats.min_cloud_size       = Utilities::MPI::min(min_size, comm);
+      stats.max_cloud_size       = Utilities::MPI::max(max_size, comm);
+    }
+
+    template <int dim>
+    std::vector<std::pair<unsigned int, double>>
+    EbfDiffusionAbc<dim>::cloud(const unsigned int a) const
+    {
+      std::vector<std::pair<unsigned int, double>> c;
+      for (unsigned int j = cloud_start[a]; j < cloud_start[a + 1]; ++j)
+        c.emplace_back(cloud_index[j], update_vector[j]);
+      return c;
+    }
+
+    template class EbfDiffusionAbc<1>;
+    template class EbfDiffusionAbc<2>;
+    template class EbfDiffusionAbc<3>;
+  } // namespace Abc
+} // namespace PeriDEAL

@@ -1,0 +1,117 @@
+#include <chrono>
+
+#include <perideal/abc/pd_unbounded_diffusion.h>
+#include <perideal/base/exceptions.h>
+
+namespace PeriDEAL
+{
+  namespace Abc
+  {
+    template <int dim>
+    PdUnboundedDiffusion<dim>::PdUnboundedDiffusion(const MPI_Comm comm)
+      : disc(comm)
+    {}
+
+    template <int dim>
+    void
+    PdUnboundedDiffusion<dim>::setup(const Domain<dim>              &domain,
+                                     const LatticeParameters        &lattice,
+                                     const DiffusionModelParameters &model,
+                                     const double                    time_step,
+                                     const TruncationBoundary        boundary,
+                                     const EbfParameters            &prm,
+                                     const Function<dim>            &initial)
+    {
+      check_parameter(domain.has_signed_distance(), "Geometry/Domain", "without signed distance",
+                      "a box or a ball (the absorbing layer needs the distance to the boundary)");
+      disc.setup(domain, lattice);
+      op = std::make_unique<DiffusionOperator<dim>>(disc, model);
+      check_parameter(time_step > 0 && time_step <= op->critical_time_step(), "Time step", time_step,
+                      "0 < dt <= " + std::to_string(op->critical_time_step()) +
+                        " (forward Euler bound of the PD operator)");
+      dt = time_step;
+      t  = 0.;
+      disc.initialize_vector(C);
+      disc.initialize_vector(rate);
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        C.local_element(i) = initial.value(disc.position[i]);
+
+      if (boundary == TruncationBoundary::neumann)
+        return;
+      const double delta    = lattice.delta;
+      const double layer    = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
+      const double h        = 1e-3 * lattice.dx;
+      // The ghost layer holds every node within delta + dx/2 of an owned node.
+      check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
+                      prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
+      check_parameter(layer >= lattice.dx - 1e-12 * lattice.dx, "Absorbing boundary/Layer thickness",
+                      layer, ">= dx (at least one node layer)");
+
+      // Absorbing nodes: the owned nodes closer than delta_L to the
+      // truncation boundary (delta_L / dx node layers); the outward normal
+      // is the gradient of the signed distance.
+      std::vector<unsigned int>   absorbing;
+      std::vector<Tensor<1, dim>> normals;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          const Point<dim> &x = disc.position[i];
+          if (-domain.signed_distance(x) < layer - 1e-8 * lattice.dx)
+            {
+              Tensor<1, dim> n;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  Point<dim> xp = x, xm = x;
+                  xp[d] += h;
+                  xm[d] -= h;
+                  n[d] = domain.signed_distance(xp) - domain.signed_distance(xm);
+                }
+              absorbing.push_back(i);
+              normals.push_back(n / n.norm());
+            }
+        }
+      std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
+      const DiffusionDispersion dispersion =
+        prm.dispersion == "local" ? DiffusionDispersion::local(op->kernel().local_coefficient()) :
+                                    DiffusionDispersion::nonlocal(op->kernel());
+      abc.reinit(disc.position, ids, absorbing, normals, dispersion, dt, prm,
+                 disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    void
+    PdUnboundedDiffusion<dim>::advance()
+    {
+      using clock      = std::chrono::steady_clock;
+      const auto start = clock::now();
+      C.update_ghost_values();
+      const auto abc_start = clock::now();
+      abc.compute(C.begin(), boundary_values);
+      const auto abc_end = clock::now();
+      op->apply(C, rate);
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        C.local_element(i) += dt * rate.local_element(i);
+      const auto set_start = clock::now();
+      const auto &absorbing = abc.absorbing_points();
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        C.local_element(absorbing[a]) = boundary_values[a];
+      const auto end = clock::now();
+      t += dt;
+      abc_seconds += std::chrono::duration<double>(abc_end - abc_start + end - set_start).count();
+      step_seconds += std::chrono::duration<double>(end - start).count();
+    }
+
+    template <int dim>
+    double
+    PdUnboundedDiffusion<dim>::energy(const BoundingBox<dim> &region) const
+    {
+      double e = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (region.point_inside(disc.position[i], 1e-10))
+          e += C.local_element(i) * C.local_element(i) * disc.volume[i];
+      return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+    }
+
+    template class PdUnboundedDiffusion<1>;
+    template class PdUnboundedDiffusion<2>;
+  } // namespace Abc
+} // namespace PeriDEAL

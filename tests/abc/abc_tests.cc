@@ -1,0 +1,517 @@
+// Tests of the EBF absorbing boundary for diffusion (dissertation Sect. 4.1,
+// paper 002) with PD and deal.II FEM near fields. Every case compares with
+// something independent: the heat kernel, an extended-domain run of the
+// same code (wide enough that nothing reaches its boundary), the Taylor
+// series (4.17) of the nonlocal dispersion relation, or the same run on a
+// different number of ranks.
+
+#include <deal.II/base/function.h>
+
+#include <deal.II/grid/grid_generator.h>
+
+#include <perideal/abc/ebf_diffusion_abc.h>
+#include <perideal/abc/pd_unbounded_diffusion.h>
+#include <perideal/base/exceptions.h>
+#include <perideal/fem/fem_diffusion.h>
+
+#include <check.h>
+
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  /** C0 = exp(-4|x|^2) and its free-space evolution under C_t = D Laplace C. */
+  template <int dim>
+  class HeatKernel : public Function<dim>
+  {
+  public:
+    HeatKernel(const double D = 1.)
+      : D(D)
+    {}
+    double
+    value(const Point<dim> &p, const unsigned int = 0) const override
+    {
+      const double s = 1. + 16. * D * this->get_time();
+      return std::pow(s, -0.5 * dim) * std::exp(-4. * p.square() / s);
+    }
+
+  private:
+    double D;
+  };
+
+  template <int dim>
+  BoundingBox<dim>
+  cube(const double L)
+  {
+    Point<dim> lo, hi;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lo[d] = -L;
+        hi[d] = L;
+      }
+    return BoundingBox<dim>(std::make_pair(lo, hi));
+  }
+
+  /** Energies on the truncated domain at every @p every-th step. */
+  struct History
+  {
+    std::vector<double> energy;
+    bool                monotone = true; // Pi non-increasing every step
+  };
+
+  template <int dim, typename Run>
+  History
+  history(Run &run, const double L, const unsigned int n_steps, const unsigned int every = 100)
+  {
+    const auto region = cube<dim>(L);
+    History    h;
+    h.energy.push_back(run.energy(region));
+    double previous = h.energy[0];
+    for (unsigned int n = 1; n <= n_steps; ++n)
+      {
+        run.advance();
+        const double e = run.energy(region);
+        h.monotone     = h.monotone && e <= previous * (1. + 1e-13);
+        previous       = e;
+        if (n % every == 0 || n == n_steps)
+          h.energy.push_back(e);
+      }
+    return h;
+  }
+
+  /** Normalized energy difference (4.35) of a run against a reference. */
+  struct Comparison
+  {
+    double max_difference = 0.; // max over the run of |Pi - Pi_ref| / Pi_ref(0)
+    double final_difference = 0.;
+    bool   monotone = true;
+    double final_energy = 0.;
+  };
+
+  Comparison
+  compare(const History &run, const History &reference)
+  {
+    Comparison c;
+    for (unsigned int r = 0; r < run.energy.size(); ++r)
+      {
+        const double d     = std::abs(run.energy[r] - reference.energy[r]) / reference.energy[0];
+        c.max_difference   = std::max(c.max_difference, d);
+        c.final_difference = d;
+      }
+    c.monotone     = run.monotone;
+    c.final_energy = run.energy.back();
+    return c;
+  }
+
+  void
+  expect_error(const std::function<void()> &f, const std::string &what)
+  {
+    try
+      {
+        f();
+        check(false, what + ": no ParameterError");
+      }
+    catch (const ParameterError &e)
+      {
+        check(true, what + ": " + e.what());
+      }
+  }
+
+  // ------------------------------------------------------------------------
+  // Nonlocal dispersion relation: quadrature of (4.13) against the Taylor
+  // series (4.15)/(4.17) (2D), the 1D and 3D series of 002 App. A, and the
+  // local limit omega -> D k^2 as k delta -> 0.
+  void
+  dispersion()
+  {
+    const double D = 1., delta = 0.5;
+    for (const unsigned int dim : {1u, 2u, 3u})
+      {
+        ScalarKernel kernel;
+        kernel.dim      = dim;
+        kernel.omega    = InfluenceFunction::constant;
+        kernel.exponent = 1.;
+        kernel.delta    = delta;
+        kernel.constant = kernel.micro_constant_for(D);
+        const auto nonlocal = Abc::DiffusionDispersion::nonlocal(kernel);
+        // Series coefficients of omega / (D k^2) in (k delta)^2, (k delta)^4:
+        // 1D (derived: omega = 2 c0 sum_{n even} (k delta)^n / (n n!), c0 = 2D/delta^2), 2D (4.17), 3D (002, (58)).
+        const double a2 = dim == 1 ? 1. / 24. : (dim == 2 ? 3. / 80. : 1. / 30.);
+        const double a4 = dim == 1 ? 1. / 1080. : (dim == 2 ? 1. / 1344. : 1. / 1680.);
+        double       previous = 1e300;
+        for (const double kd : {1., 0.3, 0.1, 0.01})
+          {
+            const double k     = kd / delta;
+            const double ratio = nonlocal(k) / (D * k * k);
+            const double gap   = std::abs(ratio - 1.);
+            check(gap < previous, std::to_string(dim) + "D: |omega/(D k^2) - 1| = " +
+                                    std::to_string(gap) + " decreases as k delta = " +
+                                    std::to_string(kd) + " -> 0");
+            previous = gap;
+            // The truncated series misses O((k delta)^6) (coefficient ~1e-5);
+            // 1e-12: round-off of the quadrature sum.
+            check_close(ratio, 1. + a2 * kd * kd + a4 * std::pow(kd, 4), 2e-4 * std::pow(kd, 6) + 1e-12,
+                        std::to_string(dim) + "D nonlocal dispersion vs Taylor series, k delta = " +
+                          std::to_string(kd));
+          }
+        check(std::abs(nonlocal(0.01 / delta) / (D * std::pow(0.01 / delta, 2)) - 1.) < 1e-4,
+              "nonlocal modes converge to local ones (4.17)");
+      }
+  }
+
+  // ------------------------------------------------------------------------
+  // Frames, mode directions and the guards.
+  void
+  frames_and_guards()
+  {
+    for (const double angle : {0., 0.3, 1.2, 2.5, -2.})
+      {
+        Tensor<1, 2> n;
+        n[0]                 = std::cos(angle);
+        n[1]                 = std::sin(angle);
+        const Tensor<1, 2> e = Abc::EbfDiffusionAbc<2>::local_frame(n) * n;
+        check(std::abs(e[0] - std::sqrt(0.5)) < 1e-14 && std::abs(e[1] - std::sqrt(0.5)) < 1e-14,
+              "2D frame (4.24) maps the normal at angle " + std::to_string(angle) +
+                " onto the quadrant bisector");
+      }
+    {
+      Tensor<1, 3> n;
+      n[0] = 0.2;
+      n[1] = -0.7;
+      n[2] = 0.4;
+      n /= n.norm();
+      const Tensor<1, 3> e = Abc::EbfDiffusionAbc<3>::local_frame(n) * n;
+      Tensor<1, 3> diagonal;
+      for (unsigned int d = 0; d < 3; ++d)
+        diagonal[d] = 1. / std::sqrt(3.);
+      check((e - diagonal).norm() < 1e-14,
+            "3D frame maps the normal onto the octant diagonal");
+    }
+    // Infinity condition (4.20)/(4.22): k < 0 and every mode direction in
+    // the first quadrant give k cos(theta* - phi) < 0 ... <= 0 at the edges.
+    for (const auto &d : Abc::EbfDiffusionAbc<2>::mode_directions(5))
+      for (double th = 0.; th < M_PI / 2.; th += 0.1)
+        check(-1. * (d[0] * std::cos(th) + d[1] * std::sin(th)) <= 1e-15 &&
+                d[0] >= -1e-15 && d[1] >= -1e-15,
+              "mode direction in the first quadrant decays at theta* = " + std::to_string(th));
+
+    // Guards: Delta k beyond (4.33), a cloud of too few points, and an
+    // unstable mode set all stop with a ParameterError naming the cloud.
+    Triangulation<1> tria;
+    GridGenerator::subdivided_hyper_cube(tria, 80, -5., 5.);
+    Fem::FemDiffusionParameters fp;
+    fp.time_step = 1e-3;
+    HeatKernel<1>      c0;
+    Abc::EbfParameters ap;
+    ap.cloud_radius = 0.25;
+    ap.wave_number_range = 40.; // 1/sqrt(D dt) = 31.6
+    expect_error([&] {
+      Fem::FemDiffusion<1> f(tria, fp);
+      f.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+    }, "Delta k above the bound (4.33)");
+    ap.wave_number_range = 0.;
+    ap.cloud_radius      = 0.2; // 2 points
+    expect_error([&] {
+      Fem::FemDiffusion<1> f(tria, fp);
+      f.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+    }, "cloud with fewer than 3 points");
+    ap.cloud_radius    = 0.25;
+    ap.max_update_norm = 0.5; // each V has its own-node weight near 1 here
+    expect_error([&] {
+      Fem::FemDiffusion<1> f(tria, fp);
+      f.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+    }, "updating vector above the max-norm guard");
+    fp.time_step = 0.01; // > dx^2 / (2 D) = 0.0078
+    expect_error([&] { Fem::FemDiffusion<1> f(tria, fp); f.setup(Abc::TruncationBoundary::neumann, ap, c0); },
+                    "explicit FEM step above the stability bound");
+  }
+
+  // ------------------------------------------------------------------------
+  // 1D classical diffusion with a deal.II FEM near field (002 Example 1,
+  // reduced: (-10, 10) to t = 40 instead of (-30, 30) to t = 250, i.e. the
+  // same ratio of diffusion length to domain size, sqrt(16 t) / L ~ 2.5).
+  template <int dim>
+  void
+  fem_case(const unsigned int degree, const bool lumped, const std::string &scheme,
+           const double L, const double dx, const double dt, const double t_end,
+           const double energy_tolerance, const double error_tolerance)
+  {
+    const auto make_mesh = [dx](Triangulation<dim> &tria, const double half_width) {
+      GridGenerator::subdivided_hyper_cube(tria, static_cast<unsigned int>(std::round(2. * half_width / dx)),
+                                           -half_width, half_width);
+    };
+    Triangulation<dim> near_tria, wide_tria;
+    make_mesh(near_tria, L);
+    make_mesh(wide_tria, 5. * L);
+    Fem::FemDiffusionParameters fp;
+    fp.degree      = degree;
+    fp.lumped_mass = lumped;
+    fp.scheme      = scheme;
+    fp.time_step   = dt;
+    Abc::EbfParameters ap;
+    ap.n_wave_numbers = 20;
+    ap.n_directions   = 5;
+    // Two node spacings (dx / degree): 3 points in 1D (002: at least 3).
+    ap.cloud_radius = 2. * dx / degree * (1. + 1e-9);
+    HeatKernel<dim> c0;
+    const auto      n_steps = static_cast<unsigned int>(std::round(t_end / dt));
+
+    std::ostringstream name;
+    name << dim << "D FEM Q" << degree << (lumped ? " lumped " : " consistent ") << scheme;
+    Fem::FemDiffusion<dim> abc_run(near_tria, fp), neumann_run(near_tria, fp), reference(wide_tria, fp);
+    abc_run.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+    neumann_run.setup(Abc::TruncationBoundary::neumann, ap, c0);
+    reference.setup(Abc::TruncationBoundary::neumann, ap, c0);
+    const auto &st = abc_run.absorbing_boundary().statistics();
+    if (root())
+      std::cout << "  " << name.str() << ": " << st.n_absorbing << " absorbing DoFs, clouds "
+                << st.min_cloud_size << ".." << st.max_cloud_size << ", Delta k "
+                << st.wave_number_range << " (bound " << st.wave_number_bound
+                << "), max cond " << st.max_condition_number << ", max |V| " << st.max_update_norm
+                << ", max sum|V| " << st.max_update_l1 << std::endl;
+    const History    ref = history<dim>(reference, L, n_steps);
+    const Comparison a   = compare(history<dim>(abc_run, L, n_steps), ref);
+    const Comparison n   = compare(history<dim>(neumann_run, L, n_steps), ref);
+    if (root())
+      std::cout << "  " << name.str() << ": Delta Pi/Pi0 ABC max " << a.max_difference << " final "
+                << a.final_difference << "; Neumann final " << n.final_difference
+                << "; ratio " << n.final_difference / a.final_difference << std::endl;
+    check(a.max_difference < energy_tolerance,
+          name.str() + ": ABC within " + std::to_string(energy_tolerance) +
+            " of the extended domain over the whole run (4.35)");
+    check(n.final_difference > 10. * a.final_difference,
+          name.str() + ": ABC at least 10x closer to the reference than Neumann at t_end");
+    check(a.monotone, name.str() + ": near-field energy non-increasing every step");
+    HeatKernel<dim> exact;
+    const double    err = abc_run.max_error(exact, cube<dim>(L));
+    const double    err_ref = reference.max_error(exact, cube<dim>(L));
+    if (root())
+      std::cout << "  " << name.str() << ": max |C - heat kernel| on the near field: ABC " << err
+                << ", extended domain " << err_ref << std::endl;
+    check(err < error_tolerance,
+          name.str() + ": max error against the heat kernel " + std::to_string(err) + " < " +
+            std::to_string(error_tolerance));
+  }
+
+  void
+  fem_1d()
+  {
+    // Tolerances: the source shows Delta Pi / Pi0 "very small" (figure
+    // only); we require 1e-3 of Pi0 over the run, i.e. well below the
+    // Neumann error (> 1e-2 here). The heat-kernel error budget 2e-3 is the
+    // discretization error of the extended run (printed) plus the ABC's.
+    fem_case<1>(1, true, "forward Euler", 10., 0.125, 1e-3, 40., 1e-3, 2e-3);
+    fem_case<1>(2, false, "backward Euler", 10., 0.25, 1e-2, 40., 1e-3, 2e-3);
+    fem_case<1>(1, false, "forward Euler", 10., 0.125, 1e-3, 10., 1e-3, 2e-3);
+  }
+
+  void
+  fem_2d()
+  {
+    // Square (-3,3)^2 to t = 3 (diffusion length sqrt(16 t) ~ 2.3 L as in
+    // 1D), reference (-15,15)^2. Measured: max Delta Pi/Pi0 8.1e-4 (Neumann
+    // 2.7e-2 at t_end), heat-kernel error 1.3e-3 (corner clouds have 6
+    // points only); tolerances: 2e-3 for both, an order below Neumann.
+    fem_case<2>(1, true, "forward Euler", 3., 0.125, 2e-3, 3., 2e-3, 2e-3);
+  }
+
+  // ------------------------------------------------------------------------
+  // PD near fields against an extended PD run.
+  /** Energy history of a PD run on (-half, half)^dim, measured on (-L, L)^dim. */
+  template <int dim>
+  History
+  pd_history(const double L, const double half, const double dx, const double m, const double dt,
+             const double t_end, const Abc::TruncationBoundary boundary, const double layer,
+             Abc::CloudStatistics *stats = nullptr, const MPI_Comm comm = MPI_COMM_WORLD)
+  {
+    LatticeParameters lp;
+    lp.dx    = dx;
+    lp.delta = m * dx;
+    DiffusionModelParameters model;
+    model.exponent    = 1.; // 002: p = 1, constant micro-diffusivity
+    model.diffusivity = 1.;
+    Abc::EbfParameters ap;
+    ap.n_wave_numbers  = 20;
+    ap.n_directions    = 5;
+    // d_inf = delta / 2 (002) in 1D; in 2D with m = 2 that gives corner clouds
+    // of 3 points (< 5, the source's minimum), so d_inf = delta there.
+    ap.cloud_radius    = (dim == 1 ? 0.5 : 1.) * lp.delta * (1. + 1e-9);
+    ap.layer_thickness = layer;
+    HeatKernel<dim> c0;
+    const auto      box = cube<dim>(half);
+    BoxDomain<dim>  domain(box.get_boundary_points().first, box.get_boundary_points().second);
+    Abc::PdUnboundedDiffusion<dim> run(comm);
+    run.setup(domain, lp, model, dt, boundary, ap, c0);
+    if (stats)
+      *stats = run.absorbing_boundary().statistics();
+    return history<dim>(run, L, static_cast<unsigned int>(std::round(t_end / dt)));
+  }
+
+  template <int dim>
+  void
+  pd_abc_vs_neumann(const double L, const double dx, const double m, const double dt,
+                    const double t_end, const double tolerance)
+  {
+    Abc::CloudStatistics st;
+    const History ref = pd_history<dim>(L, 5. * L, dx, m, dt, t_end, Abc::TruncationBoundary::neumann, 0.);
+    const auto    a   = compare(pd_history<dim>(L, L, dx, m, dt, t_end, Abc::TruncationBoundary::absorbing, 0., &st), ref);
+    const auto    n   = compare(pd_history<dim>(L, L, dx, m, dt, t_end, Abc::TruncationBoundary::neumann, 0.), ref);
+    std::ostringstream name;
+    name << dim << "D PD (m = " << m << ")";
+    if (root())
+      std::cout << "  " << name.str() << ": " << st.n_absorbing << " absorbing nodes, clouds "
+                << st.min_cloud_size << ".." << st.max_cloud_size << ", max cond "
+                << st.max_condition_number << ", max |V| " << st.max_update_norm
+                << "; Delta Pi/Pi0 ABC max " << a.max_difference << " final " << a.final_difference
+                << "; Neumann final " << n.final_difference << "; ratio "
+                << n.final_difference / a.final_difference << std::endl;
+    check(a.max_difference < tolerance, name.str() + ": ABC within " + std::to_string(tolerance) +
+                                          " of the extended PD run over the whole run (4.35)");
+    check(n.final_difference > 10. * a.final_difference,
+          name.str() + ": ABC at least 10x closer to the reference than Neumann at t_end");
+    check(a.monotone, name.str() + ": near-field energy non-increasing every step");
+  }
+
+  void
+  pd_1d()
+  {
+    // 002 Example 1 reduced as fem_1d: delta = 4 dx, d_inf = delta/2,
+    // delta_L = delta. Tolerance as for FEM.
+    pd_abc_vs_neumann<1>(10., 0.125, 4., 1e-3, 40., 1e-3);
+  }
+
+  void
+  pd_2d()
+  {
+    // Measured max Delta Pi/Pi0 1.6e-3 (Neumann 2.7e-2); tolerance as for FEM 2D.
+    pd_abc_vs_neumann<2>(3., 0.125, 2., 1e-3, 3., 2e-3);
+  }
+
+  // Layer study of 002 Example 1 / Fig. 4.11 (reduced): the error decreases
+  // with delta_L; the source finds delta_L >= 3 dx adequate.
+  void
+  pd_layer_study()
+  {
+    std::vector<double> d;
+    const History ref = pd_history<1>(10., 50., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::neumann, 0.);
+    for (const unsigned int layers : {1u, 2u, 3u, 4u})
+      {
+        const auto c = compare(pd_history<1>(10., 10., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::absorbing,
+                                             layers * 0.125), ref);
+        d.push_back(c.max_difference);
+        if (root())
+          std::cout << "  delta_L = " << layers << " dx: max Delta Pi/Pi0 " << c.max_difference
+                    << ", final " << c.final_difference << std::endl;
+      }
+    check(d[1] > d[2] && d[2] > d[3], "error decreases as delta_L grows from 2 dx to 4 dx (Fig. 4.11)");
+    // delta_L = dx diverges here (the source shows only reduced accuracy;
+    // see step-5/doc.md): asserted as "not better than 2 dx".
+    check(!(d[0] <= d[1]), "delta_L = dx not more accurate than 2 dx");
+  }
+
+  // Same PD run on all ranks and on rank 0 alone: identical energies.
+  void
+  pd_rank_invariance()
+  {
+    for (const unsigned int dim : {1u, 2u})
+      {
+        const auto run = [dim](const MPI_Comm comm) {
+          const History h =
+            dim == 1 ? pd_history<1>(4., 4., 0.125, 4., 1e-3, 2., Abc::TruncationBoundary::absorbing, 0., nullptr, comm) :
+                       pd_history<2>(2., 2., 0.125, 2., 1e-3, 0.5, Abc::TruncationBoundary::absorbing, 0., nullptr, comm);
+          return compare(h, h);
+        };
+        const Comparison all = run(MPI_COMM_WORLD);
+        Comparison       one = all;
+        if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+          one = run(MPI_COMM_SELF);
+        const double e1 = Utilities::MPI::broadcast(MPI_COMM_WORLD, one.final_energy, 0);
+        check_close(all.final_energy, e1, 1e-13,
+                    std::to_string(dim) + "D PD with ABC: near-field energy on " +
+                      std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) +
+                      " ranks vs 1 rank");
+      }
+  }
+
+  // Long run: energy non-increasing over 1e6 steps (1D FEM and PD).
+  void
+  long_stability()
+  {
+    for (const bool pd : {false, true})
+      {
+        const double L = 10., dx = 0.125, dt = 1e-3;
+        const unsigned int n_steps = 1000000;
+        const auto   region        = cube<1>(L);
+        HeatKernel<1>      c0;
+        Abc::EbfParameters ap;
+        ap.cloud_radius = 0.25 * (1. + 1e-9); // d_inf = delta / 2 = 2 dx
+        bool   monotone = true;
+        double e0 = 0., e = 0.;
+        const auto march = [&](auto &run) {
+          e0 = e = run.energy(region);
+          for (unsigned int n = 0; n < n_steps; ++n)
+            {
+              run.advance();
+              const double en = run.energy(region);
+              monotone        = monotone && en <= e * (1. + 1e-13);
+              e               = en;
+            }
+        };
+        if (pd)
+          {
+            LatticeParameters lp;
+            lp.dx    = dx;
+            lp.delta = 4 * dx;
+            DiffusionModelParameters model;
+            model.exponent = 1.;
+            BoxDomain<1> box(Point<1>(-L), Point<1>(L));
+            Abc::PdUnboundedDiffusion<1> run(MPI_COMM_SELF);
+            run.setup(box, lp, model, dt, Abc::TruncationBoundary::absorbing, ap, c0);
+            march(run);
+          }
+        else
+          {
+            Triangulation<1> tria;
+            GridGenerator::subdivided_hyper_cube(tria, 160, -L, L);
+            Fem::FemDiffusionParameters fp;
+            fp.time_step = dt;
+            Fem::FemDiffusion<1> run(tria, fp);
+            run.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+            march(run);
+          }
+        if (root())
+          std::cout << "  " << (pd ? "PD" : "FEM") << ": Pi(t=1000)/Pi0 = " << e / e0 << std::endl;
+        check(monotone, std::string(pd ? "PD" : "FEM") + " 1D: energy non-increasing over 1e6 steps");
+        // Heat kernel on (-L, L): Pi(t) = sqrt(pi/(8 s)) erf(L sqrt(8/s)), s = 1 + 16 t.
+        const auto exact_pi = [L](const double t) {
+          const double s = 1. + 16. * t;
+          return std::sqrt(M_PI / (8. * s)) * std::erf(L * std::sqrt(8. / s));
+        };
+        const double ratio_exact = exact_pi(1000.) / exact_pi(0.);
+        check(std::isfinite(e) && std::abs(e / e0 - ratio_exact) < 1e-3,
+              "Pi(1000)/Pi(0) = " + std::to_string(e / e0) + " within 1e-3 (the (4.35) tolerance) of the heat kernel's " +
+                std::to_string(ratio_exact));
+      }
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv,
+             {{"dispersion", dispersion},
+              {"frames_and_guards", frames_and_guards},
+              {"fem_1d", fem_1d},
+              {"fem_2d", fem_2d},
+              {"pd_1d", pd_1d},
+              {"pd_2d", pd_2d},
+              {"pd_layer_study", pd_layer_study},
+              {"pd_rank_invariance", pd_rank_invariance},
+              {"long_stability", long_stability}});
+}

@@ -1,0 +1,17 @@
+perideal_add_test_program(abc_tests ${CMAKE_CURRENT_LIST_DIR}/abc_tests.cc)
+
+foreach(_t dispersion frames_and_guards)
+  perideal_add_test(NAME abc.${_t} COMMAND $<TARGET_FILE:abc_tests> ${_t} LABELS unit)
+endforeach()
+foreach(_t fem_1d fem_2d pd_1d pd_2d pd_layer_study)
+  perideal_add_test(NAME abc.${_t} COMMAND $<TARGET_FILE:abc_tests> ${_t} LABELS convergence)
+endforeach()
+perideal_add_test(NAME abc.pd_rank_invariance.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:abc_tests> pd_rank_invariance LABELS mpi)
+perideal_add_test(NAME abc.long_stability COMMAND $<TARGET_FILE:abc_tests> long_stability
+  LABELS long TIMEOUT 3000)
+# step-5 with a reduced near field (-10, 10), reference (-50, 50), t_f = 40.
+perideal_add_test(NAME abc.tutorial.step-5 COMMAND $<TARGET_FILE:step-5> ${CMAKE_CURRENT_LIST_DIR}/step-5-ci.prm
+  LABELS tutorial)
+perideal_add_test(NAME abc.tutorial.step-5.full COMMAND $<TARGET_FILE:step-5> ${CMAKE_SOURCE_DIR}/tutorial/step-5/step-5.prm
+  LABELS "tutorial;long" TIMEOUT 7200)
