@@ -241,6 +241,24 @@ namespace PeriDEAL
     Tensor<1, 2>
     FictitiousNodeProblem::generalized_normal(const unsigned int k, const bool across_crack) const
     {
+      return generalized_normal(k, across_crack, numbers::invalid_unsigned_int);
+    }
+
+    bool
+    FictitiousNodeProblem::in_omega_part(const unsigned int k,
+                                         const unsigned int j,
+                                         const bool         across_crack,
+                                         const unsigned int side) const
+    {
+      return in_domain[j] && cut(k, j) == across_crack &&
+             (side == numbers::invalid_unsigned_int || j == side || !cut(side, j));
+    }
+
+    Tensor<1, 2>
+    FictitiousNodeProblem::generalized_normal(const unsigned int k,
+                                              const bool         across_crack,
+                                              const unsigned int side) const
+    {
       // (15): the PD gradient of r over the domain part H^Omega of the
       // family (connected domain nodes; for a node seen across a crack, the
       // disconnected ones), with partial volumes; (16): normalized.
@@ -250,9 +268,7 @@ namespace PeriDEAL
           {
             const double       w = weight(a, b);
             const unsigned int j = node_at(lattice[k][0] + a, lattice[k][1] + b);
-            if (w <= 0. || j == numbers::invalid_unsigned_int || !in_domain[j])
-              continue;
-            if (cut(k, j) != across_crack)
+            if (w <= 0. || j == numbers::invalid_unsigned_int || !in_omega_part(k, j, across_crack, side))
               continue;
             g += w * index_function[j] * (position[j] - position[k]);
           }
@@ -266,7 +282,6 @@ namespace PeriDEAL
       fictitious.clear();
       fictitious_of_node.assign(position.size(), numbers::invalid_unsigned_int);
       crack_fictitious_of_node.assign(position.size(), numbers::invalid_unsigned_int);
-      const double dx = prm.dx;
       for (unsigned int k = 0; k < position.size(); ++k)
         for (const bool across : {false, true})
           {
@@ -285,10 +300,19 @@ namespace PeriDEAL
             if (!needed)
               continue;
 
+            (across ? crack_fictitious_of_node : fictitious_of_node)[k] = fictitious.size();
+            fictitious.push_back(make_mirror(k, across, numbers::invalid_unsigned_int));
+          }
+    }
+
+    FictitiousNode
+    FictitiousNodeProblem::make_mirror(const unsigned int k, const bool across, const unsigned int side) const
+    {
+      const double dx = prm.dx;
             FictitiousNode f;
             f.node         = k;
             f.across_crack = across;
-            f.normal       = generalized_normal(k, across);
+            f.normal       = generalized_normal(k, across, side);
             if (f.normal.norm() > 0.)
               {
                 // The closest node of H^Omega within dx/2 of the normal line.
@@ -298,7 +322,7 @@ namespace PeriDEAL
                     {
                       const unsigned int j = node_at(lattice[k][0] + a, lattice[k][1] + b);
                       if (weight(a, b) <= 0. || j == numbers::invalid_unsigned_int ||
-                          !in_domain[j] || cut(k, j) != across)
+                          !in_omega_part(k, j, across, side))
                         continue;
                       const Tensor<1, 2> xi = position[j] - position[k];
                       const double       t  = xi * f.normal;
@@ -335,9 +359,7 @@ namespace PeriDEAL
                         }
                     }
               }
-            (across ? crack_fictitious_of_node : fictitious_of_node)[k] = fictitious.size();
-            fictitious.push_back(f);
-          }
+      return f;
     }
 
     Point<2>
@@ -423,15 +445,19 @@ namespace PeriDEAL
                     // Across a crack (insulated): the mirror FNM uses the
                     // fictitious value u_m of (11) with zero flux; naive and
                     // Taylor drop the bond (their zero-flux form).
-                    const FictitiousNode *f =
-                      crack_fictitious_of_node[j] == numbers::invalid_unsigned_int ?
-                        nullptr :
-                        &fictitious[crack_fictitious_of_node[j]];
-                    if (prm.method == FictitiousNodeMethod::mirror && f != nullptr &&
-                        f->mirror != numbers::invalid_unsigned_int)
+                    // The mirror is searched among the nodes on the side of
+                    // row i (make_mirror with side i): with one straight crack
+                    // this is the paper's per-node mirror; at crossing cracks
+                    // a node is fictitious for several regions, and one value
+                    // per node would couple regions the cracks separate.
+                    if (prm.method == FictitiousNodeMethod::mirror)
                       {
-                        row[unknown[f->mirror]] += w;
-                        row[unknown[i]] -= w;
+                        const FictitiousNode f = make_mirror(j, true, i);
+                        if (f.mirror != numbers::invalid_unsigned_int)
+                          {
+                            row[unknown[f.mirror]] += w;
+                            row[unknown[i]] -= w;
+                          }
                       }
                     continue;
                   }

@@ -20,6 +20,15 @@ namespace PeriDEAL
       LocalCondition
       motz_condition(const Point<2> &p)
       {
+        // Outside the rectangle the clamped (closest) boundary point decides,
+        // and at the corners (1, 0), (1, 1) and D = (-1, 0) the Dirichlet
+        // data hold (the series (21) satisfies them there).
+        if (p[0] >= 1.)
+          return LocalCondition::make_dirichlet(500.);
+        if (p[1] <= 0.)
+          return p[0] <= 0. ? LocalCondition::make_dirichlet(0.) : LocalCondition::make_neumann(0.);
+        if (p[0] <= -1. || p[1] >= 1.)
+          return LocalCondition::make_neumann(0.);
         const double right = std::abs(p[0] - 1.), bottom = std::abs(p[1]);
         const double left = std::abs(p[0] + 1.), top = std::abs(p[1] - 1.);
         const double other = std::min(left, top);
@@ -33,12 +42,12 @@ namespace PeriDEAL
       double
       motz_series(const Point<2> &p)
       {
-        static const std::array<double, 20> D = {
+        static const std::array<double, 20> D = {{
           401.162453745234,   87.6559201950879,    17.2379150794468,   -8.07121525969878,
           1.44027271702239,   0.331054885920006,   0.275437344507861,  -0.0869329945041108,
           0.0336048784027429, 0.0153843744594011,  7.30230164737158e-3, -3.18411361654663e-3,
           1.22064586154975e-3, 5.30965295822851e-4, 2.71512022889082e-4, -1.20045043773288e-4,
-          5.05389241414920e-5, 2.31662561135488e-5, 1.15348467265589e-5, -5.29323807785491e-6};
+          5.05389241414920e-5, 2.31662561135488e-5, 1.15348467265589e-5, -5.29323807785491e-6}};
         const double rho = p.norm(), theta = std::atan2(p[1], p[0]);
         double       u   = 0.;
         for (unsigned int i = 0; i < D.size(); ++i)

@@ -9,6 +9,7 @@
 #include <deal.II/fe/fe_values.h>
 
 #include <deal.II/grid/grid_refinement.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/manifold_lib.h>
 #include <deal.II/grid/tria_accessor.h>
 #include <deal.II/grid/tria_iterator.h>
@@ -215,17 +216,20 @@ namespace PeriDEAL
         for (unsigned int i = 0; i < 5; ++i)
           for (unsigned int j = 0; j < 4; ++j)
             cells[i].vertices[j] = c[i][j];
+        GridTools::consistently_order_cells(cells);
         coarse.create_triangulation(v, cells, SubCellData());
       }
       const SphericalManifold<2> circle;
-      const auto                 mark_circle = [&](Triangulation<2> &t) {
+      // Boundary faces on the circle (not on a crack: those are within
+      // a of the center) follow the circle.
+      const auto mark_circle = [&](Triangulation<2> &t, const double threshold) {
         for (const auto &cell : t.active_cell_iterators())
           for (const auto &face : cell->face_iterators())
-            if (face->at_boundary() && face->center().norm() > 1.2 * a * std::sqrt(2.))
+            if (face->at_boundary() && face->center().norm() > threshold)
               face->set_manifold_id(0);
         t.set_manifold(0, circle);
       };
-      mark_circle(coarse);
+      mark_circle(coarse, 0.);
       coarse.refine_global(n_refinements);
 
       // Duplicate the vertices on the open cracks: one copy per side.
@@ -291,7 +295,7 @@ namespace PeriDEAL
 
       auto tria = std::make_unique<Triangulation<2>>();
       tria->create_triangulation(compact, cells, SubCellData());
-      mark_circle(*tria);
+      mark_circle(*tria, a + 0.5 * (radius - a));
       return tria;
     }
   } // namespace Fem

@@ -1,12 +1,11 @@
 perideal_add_test_program(fnm_tests ${CMAKE_CURRENT_LIST_DIR}/fnm_tests.cc)
 
-foreach(_t mirror_square mirror_reentrant mirror_crack mirror_circle bad_input)
-  perideal_add_test(NAME fnm.${_t} COMMAND $<TARGET_FILE:fnm_tests> ${_t} LABELS unit)
-endforeach()
-foreach(_t square_linear square_convergence disk_harmonic motz cracked_disk crossing_cracks)
+# mirror_square mirror_reentrant mirror_crack mirror_circle crack_mesh bad_input
+perideal_add_test(NAME fnm.unit COMMAND $<TARGET_FILE:fnm_tests> unit LABELS unit)
+foreach(_t square_linear disk_harmonic motz cracked_disk crossing_cracks)
   perideal_add_test(NAME fnm.${_t} COMMAND $<TARGET_FILE:fnm_tests> ${_t} LABELS convergence)
 endforeach()
-foreach(_t motz_convergence cracked_disk_fine crossing_cracks_fine)
+foreach(_t square_convergence motz_convergence cracked_disk_fine crossing_cracks_fine)
   perideal_add_test(NAME fnm.${_t} COMMAND $<TARGET_FILE:fnm_tests> ${_t}
     LABELS "convergence;long" TIMEOUT 3000)
 endforeach()

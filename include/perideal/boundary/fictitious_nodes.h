@@ -208,6 +208,16 @@ namespace PeriDEAL
       /** The boundary point on the segment from inside @p a to outside @p b. */
       Point<2>
       intersect(const Point<2> &a, const Point<2> &b) const;
+      /** Node j belongs to H^Omega of k (and, if side is valid, is connected to side). */
+      bool
+      in_omega_part(const unsigned int k, const unsigned int j, const bool across_crack,
+                    const unsigned int side) const;
+      /** (15)-(16) restricted to the nodes connected to @p side (invalid: all). */
+      Tensor<1, 2>
+      generalized_normal(const unsigned int k, const bool across_crack, const unsigned int side) const;
+      /** Sect. 3.4 steps 2a-2c for fictitious node k (H^Omega restricted to @p side). */
+      FictitiousNode
+      make_mirror(const unsigned int k, const bool across, const unsigned int side) const;
       void
       compute_index_function();
       void
