@@ -1,0 +1,248 @@
+#ifndef perideal_boundary_fictitious_nodes_h
+#define perideal_boundary_fictitious_nodes_h
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <perideal/discretization/domain.h>
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  namespace Boundary
+  {
+    using namespace dealii;
+
+    /**
+     * The three ways of imposing a local boundary condition on steady PD
+     * diffusion through the fictitious region Gamma (paper 004, Sect. 3):
+     * naive (fictitious value = boundary value, or dropped for Neumann),
+     * Taylor (per bond, (6)-(9), with the stabilization (7)) and mirror
+     * (per fictitious node, (10)-(12), mirror nodes from Sect. 3.4).
+     */
+    enum class FictitiousNodeMethod
+    {
+      naive,
+      taylor,
+      mirror
+    };
+
+    /** Parse "naive", "taylor" or "mirror"; throws ParameterError otherwise. */
+    FictitiousNodeMethod
+    parse_fictitious_node_method(const std::string &name,
+                                 const std::string &parameter = "Fictitious node method");
+
+    /** The name used in parameter files. */
+    std::string
+    to_string(const FictitiousNodeMethod method);
+
+    /** A straight crack from a to b (2D). */
+    struct Crack
+    {
+      Point<2> a, b;
+    };
+
+    /**
+     * True if the closed segments [p, q] and [c.a, c.b] intersect (a bond
+     * touching a crack, e.g. at its tip, counts as cut).
+     */
+    bool
+    crosses(const Point<2> &p, const Point<2> &q, const Crack &c);
+
+    /**
+     * A local boundary condition at a boundary point: u = value (Dirichlet),
+     * or grad u . n = value + alpha u with n the OUTWARD unit normal (Robin;
+     * Neumann for alpha = 0).
+     */
+    struct LocalCondition
+    {
+      enum Type
+      {
+        dirichlet,
+        robin
+      } type       = dirichlet;
+      double value = 0.;
+      double alpha = 0.;
+
+      static LocalCondition
+      make_dirichlet(const double u)
+      {
+        return {dirichlet, u, 0.};
+      }
+      static LocalCondition
+      make_neumann(const double flux)
+      {
+        return {robin, flux, 0.};
+      }
+    };
+
+    /** The boundary data: the condition at a point of (or near) the boundary. */
+    using BoundaryData = std::function<LocalCondition(const Point<2> &)>;
+
+    /** Parameters of a FictitiousNodeProblem. */
+    struct FictitiousNodeParameters
+    {
+      /** Lattice spacing dx (> 0); the lattice is cell centered. */
+      double dx = 0.01;
+      /** Horizon delta (>= dx). */
+      double delta = 0.04;
+      FictitiousNodeMethod method = FictitiousNodeMethod::mirror;
+      /** lambda of the stabilized Taylor FNM (7) (>= 1; paper: 1.5). */
+      double taylor_lambda = 1.5;
+      /** Relative GMRES residual tolerance (in (0, 1)). */
+      double tolerance = 1e-11;
+    };
+
+    /**
+     * One fictitious node of the mirror FNM (Sect. 3.4 of paper 004): a node
+     * of the collar Gamma, or a domain node seen from across a crack.
+     */
+    struct FictitiousNode
+    {
+      /** Index of the node in FictitiousNodeProblem's node arrays. */
+      unsigned int node = 0;
+      /** True for a domain node acting as fictitious across a crack. */
+      bool across_crack = false;
+      /** The generalized normal n_Gamma of (16), pointing into the domain. */
+      Tensor<1, 2> normal;
+      /** The closest domain node x_c on the normal line (invalid: none). */
+      unsigned int closest = numbers::invalid_unsigned_int;
+      /** The ideal mirror point q and the boundary point x_b (midpoint). */
+      Point<2> mirror_point, boundary_point;
+      /** The mirror node x_m: the domain node closest to q (invalid: none). */
+      unsigned int mirror = numbers::invalid_unsigned_int;
+    };
+
+    /**
+     * Steady PD diffusion (004, (4) / (A.1)) with kernel A / |xi|^2 on a
+     * cell-centered lattice,
+     * @f[ \sum_{j \in H_i} \frac{\beta_{ij} V_j}{|\xi_{ij}|^2} (u_j - u_i) = 0, @f]
+     * with local boundary conditions imposed through the fictitious collar
+     * Gamma of width delta around the body (the Discretization's volume
+     * constraint layer) and through the crack faces: a bond that crosses a
+     * crack is not used, and the node across the crack supplies a
+     * fictitious value instead (crack faces are insulated).
+     *
+     * The nodes come from Discretization::setup (domain + layer) and are
+     * gathered on every rank, so the geometric step (index function (14),
+     * generalized normals (15)-(16), mirror nodes) is replicated and its
+     * result independent of the rank count; the fictitious relations are
+     * eliminated into the rows of the domain nodes, which are distributed
+     * over the ranks as one Trilinos matrix (in the numbering of node ids)
+     * and solved by GMRES with an AMG preconditioner.
+     */
+    class FictitiousNodeProblem
+    {
+    public:
+      /**
+       * Set up the lattice for the body @p domain (which must have a signed
+       * distance) with @p cracks, and run the mirror-node algorithm.
+       */
+      FictitiousNodeProblem(const MPI_Comm                  comm,
+                            const Domain<2>                &domain,
+                            const std::vector<Crack>       &cracks,
+                            const FictitiousNodeParameters &parameters);
+
+      /** Solve the steady problem with the boundary data @p bc. */
+      void
+      solve(const BoundaryData &bc);
+
+      /** @name Nodes (replicated, sorted by lattice id) */
+      /** @{ */
+      std::vector<Point<2>> position;
+      /** True for nodes of the body, false for collar nodes. */
+      std::vector<bool> in_domain;
+      /** The index function r of (14) (domain nodes; 0 on the collar). */
+      std::vector<double> index_function;
+      /** The solution on the domain nodes (NaN on collar nodes). */
+      std::vector<double> solution;
+      /** @} */
+
+      /** The fictitious nodes with their mirror data. */
+      std::vector<FictitiousNode> fictitious;
+
+      /** Number of domain nodes (unknowns). */
+      unsigned int
+      n_unknowns() const
+      {
+        return n_domain;
+      }
+      /** GMRES iterations of the last solve. */
+      unsigned int last_iterations = 0;
+      /** Wall time of the last solve (assembly + solver) [s]. */
+      double last_solve_seconds = 0.;
+
+      /** Node index at lattice position (i, j), or invalid. */
+      unsigned int
+      node_at(const int i, const int j) const;
+
+      /** The generalized normal (15)-(16) at an arbitrary node (used by tests). */
+      Tensor<1, 2>
+      generalized_normal(const unsigned int node, const bool across_crack) const;
+
+      /** Value at @p p: the node value, or the mean of the 4 nearest domain nodes. */
+      double
+      value_at(const Point<2> &p) const;
+
+      const FictitiousNodeParameters &
+      parameters() const
+      {
+        return prm;
+      }
+
+    private:
+      /** Bond weight beta V / |xi|^2 of lattice offset (di, dj) (0: no bond). */
+      double
+      weight(const int di, const int dj) const;
+      /** True if the segment between nodes crosses a crack. */
+      bool
+      cut(const unsigned int i, const unsigned int j) const;
+      /** The closest boundary point of an outside point (signed distance projection). */
+      Point<2>
+      project(const Point<2> &p) const;
+      /** The boundary point on the segment from inside @p a to outside @p b. */
+      Point<2>
+      intersect(const Point<2> &a, const Point<2> &b) const;
+      /** Node j belongs to H^Omega of k (and, if side is valid, is connected to side). */
+      bool
+      in_omega_part(const unsigned int k, const unsigned int j, const bool across_crack,
+                    const unsigned int side) const;
+      /** (15)-(16) restricted to the nodes connected to @p side (invalid: all). */
+      Tensor<1, 2>
+      generalized_normal(const unsigned int k, const bool across_crack, const unsigned int side) const;
+      /** Sect. 3.4 steps 2a-2c for fictitious node k (H^Omega restricted to @p side). */
+      FictitiousNode
+      make_mirror(const unsigned int k, const bool across, const unsigned int side) const;
+      void
+      compute_index_function();
+      void
+      compute_mirror_nodes();
+
+      MPI_Comm                 comm;
+      const Domain<2>         &domain;
+      std::vector<Crack>       cracks;
+      FictitiousNodeParameters prm;
+      int                      n_lattice[2] = {0, 0};
+      Point<2>                 origin;
+      /** Node index of each lattice point (invalid: none). */
+      std::vector<unsigned int> node_of_lattice;
+      std::vector<std::array<int, 2>> lattice;
+      /** Unknown number of each domain node. */
+      std::vector<unsigned int> unknown;
+      unsigned int              n_domain = 0;
+      /** Nodes within delta + dx of a crack (bond cuts are only tested there). */
+      std::vector<bool> near_crack;
+      /** Index into fictitious per node (collar role / crack role). */
+      std::vector<unsigned int> fictitious_of_node, crack_fictitious_of_node;
+      int                       reach = 0;
+      std::vector<double>       weights;
+    };
+  } // namespace Boundary
+} // namespace PeriDEAL
+
+#endif
