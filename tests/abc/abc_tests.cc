@@ -461,15 +461,20 @@ namespace
           }
       return 2. * kappa * s;
     };
+    // k in [0, 40] (exp(-100) beyond), 800 Gauss panels; lambda tabulated once.
+    std::vector<double> k_q, w_q, lambda_q;
+    for (unsigned int i = 0; i < 800; ++i)
+      for (unsigned int q = 0; q < gauss.size(); ++q)
+        {
+          const double k = (i + gauss.point(q)[0]) * 0.05;
+          k_q.push_back(k);
+          w_q.push_back(gauss.weight(q) * 0.05 * 0.5 * std::sqrt(M_PI) * std::exp(-k * k / 16.));
+          lambda_q.push_back(lambda(k));
+        }
     const auto fourier = [&](const double x, const double t) {
       double s = 0.;
-      for (unsigned int i = 0; i < 800; ++i) // k in [0, 40]: exp(-100) beyond
-        for (unsigned int q = 0; q < gauss.size(); ++q)
-          {
-            const double k = (i + gauss.point(q)[0]) * 0.05;
-            s += gauss.weight(q) * 0.05 * 0.5 * std::sqrt(M_PI) * std::exp(-k * k / 16.) *
-                 std::exp(-lambda(k) * t) * std::cos(k * x);
-          }
+      for (unsigned int j = 0; j < k_q.size(); ++j)
+        s += w_q[j] * std::exp(-lambda_q[j] * t) * std::cos(k_q[j] * x);
       return s / M_PI;
     };
     check_close(fourier(0.3, 0.), std::exp(-4. * 0.09), 1e-10, "Fourier integral reproduces C0");
