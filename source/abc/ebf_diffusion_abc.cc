@@ -201,7 +201,7 @@ namespace PeriDEAL
       // Default Delta k: the source does not report its Delta k. These are
       // the best values of scans on the Gaussian problems (d_inf = 0.25):
       // 1D Delta k in {0.1, 0.25, 0.5, 1, 2, 4} -> 0.5 = 1/(8 d_inf); 2D
-      // {0.5, 2, 4, 8, 12, 16} -> 8 = 2/d_inf (<= 2 unstable, >= 12
+      // {0.5, 2, 4, 8, 12, 16} -> 8 = 2/d_inf (<= 2 diverges, >= 12
       // over-absorbing); see tutorial/step-5/doc.md.
       const double dk = prm.wave_number_range > 0 ? prm.wave_number_range :
                                                     (dim == 1 ? 0.125 : 2.) / prm.cloud_radius;
