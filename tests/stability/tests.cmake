@@ -15,3 +15,5 @@ perideal_add_test(NAME tutorial.step-13 COMMAND $<TARGET_FILE:step-13>
   ${CMAKE_CURRENT_LIST_DIR}/step-13-small.prm LABELS "tutorial;convergence")
 perideal_add_test(NAME tutorial.step-13.long COMMAND $<TARGET_FILE:step-13>
   ${CMAKE_SOURCE_DIR}/tutorial/step-13/step-13.prm LABELS "tutorial;convergence;long" TIMEOUT 3600)
+perideal_add_test(NAME stability.library_phase_rule.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:stability_tests> library_phase_rule LABELS "unit;mpi")
