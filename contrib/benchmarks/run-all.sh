@@ -14,6 +14,7 @@
 #               the Debian packages lammps and lammps-examples when `lmp` is
 #               missing)
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
+#   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -48,12 +49,13 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
 pmb_exe="$build/contrib/benchmarks/pmb_benchmark"
-for e in "$exe" "$pmb_exe"; do
+abc_exe="$build/contrib/benchmarks/abc_benchmark"
+for e in "$exe" "$pmb_exe" "$abc_exe"; do
   [ -x "$e" ] || { echo "run-all: $e was not built" >&2; exit 1; }
 done
 
@@ -268,5 +270,8 @@ EOF_LMP
       printf "lammps_agreement_pass: %d\n", ok
     }' "$work/perideal_agreement.txt" "$work/dump.agreement" | tee -a "$results"
 fi
+# EBF absorbing boundaries: ABC work as a fraction of the step time (serial).
+"$abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
+
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"
 echo "run-all: results in $results" >&2
