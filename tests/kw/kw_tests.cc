@@ -10,6 +10,7 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/time_stepping/diffusion_solver.h>
 #include <perideal/time_stepping/mechanics_solver.h>
 
 #include "../check.h"
@@ -305,6 +306,40 @@ namespace
     check_close(sum / n, T / (p.density * c), 5e-3,
                 "mean particle velocity behind the front = T / (rho c)");
   }
+
+  // Bad mechanics input: one ParameterError naming the entry.
+  void
+  bad_input()
+  {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+      {"subsection Mechanics\n set Tractions = y - 1 : 0; 1\nend\n", "Mechanics/Tractions"},
+      {"subsection Mechanics\n set Tractions = y - 1 : 0; 1 : -2\nend\n", "Mechanics/Tractions"},
+      {"subsection Mechanics\n set Pre-cracks = 0, 0, 1, 1, 2, 2\nend\n", "Mechanics/Pre-cracks"},
+      {"subsection Mechanics\n set Prescribed displacements = y - 1\nend\n",
+       "Mechanics/Prescribed displacements"},
+      {"subsection Measurements\n set Crack origin = 1, 2, 3, 4\nend\n", "Measurements/Crack origin"},
+      {"subsection Measurements\n set Damage threshold = 1.5\nend\n", "Measurements/Damage threshold"},
+      {"subsection Measurements\n set Crack fit radii = 5, 2\nend\n", "Measurements/Crack fit radii"},
+      {"subsection Measurements\n set Energy circle = 1, 2\nend\n", "Measurements/Energy circle"}};
+    for (const auto &[text, entry] : cases)
+      {
+        ParameterHandler prm;
+        DiffusionRunParameters<2>::declare_parameters(prm);
+        MechanicsRunParameters<2>::declare_parameters(prm);
+        prm.parse_input_from_string(text);
+        std::string thrown = "(nothing)";
+        try
+          {
+            MechanicsRunParameters<2> p;
+            p.parse_parameters(prm);
+          }
+        catch (const ParameterError &e)
+          {
+            thrown = e.parameter;
+          }
+        check(thrown == entry, "ParameterError '" + thrown + "' for " + entry);
+      }
+  }
 } // namespace
 
 int
@@ -314,5 +349,6 @@ main(int argc, char **argv)
              {{"precrack_3d", precrack_3d},
               {"measurements", measurements},
               {"prescribed", prescribed_and_reaction},
-              {"traction_wave", traction_wave}});
+              {"traction_wave", traction_wave},
+              {"bad_input", bad_input}});
 }
