@@ -16,6 +16,7 @@
 #include "../check.h"
 
 #include <map>
+#include <sstream>
 
 using namespace dealii;
 using namespace PeriDEAL;
@@ -23,6 +24,15 @@ using namespace PeriDEALTests;
 
 namespace
 {
+  std::string
+  sci(const double x)
+  {
+    std::ostringstream s;
+    s.precision(3);
+    s << std::scientific << x;
+    return s.str();
+  }
+
   // Break every bond of @p op for which @p cut(p, q) holds (p, q ordered by
   // node id, as break_bonds() calls it) and count the copies.
   template <int dim, typename Cut>
@@ -225,11 +235,11 @@ namespace
     check(sv.model().n_broken_bonds() > sv.time_series().front()[4],
           "bonds break during the run (" + std::to_string(sv.model().n_broken_bonds()) + ")");
     check(R[1] > 0., "the top grip pulls: reaction_2_y = " + std::to_string(R[1]) + " > 0");
-    check(diff <= 1e-12, "u = v0 t equals v = v0: max |u diff| " + std::to_string(diff) +
+    check(diff <= 1e-12, "u = v0 t equals v = v0: max |u diff| " + sci(diff) +
                            " over " + std::to_string(steps) + " steps");
     check(balance <= 1e-12 * std::max(scale, 1e-300) + 1e-15,
           "momentum balance of the free nodes with the reaction forces: " +
-            std::to_string(balance) + " (impulse scale " + std::to_string(scale) + ")");
+            sci(balance) + " (impulse scale " + sci(scale) + ")");
     check(sd.time_series().size() == sv.time_series().size() &&
             sd.time_series_columns().size() == sv.time_series_columns().size(),
           "same CSV layout for displacement and velocity sets");
