@@ -397,8 +397,11 @@ namespace PeriDEAL
         length         = std::max(length, r);
         if (r < prm.crack_fit_min_radius || r > prm.crack_fit_max_radius)
           continue;
+        // In the x-y plane (measure_crack is off in 1D; the index is kept
+        // valid for the 1D instantiation).
+        constexpr unsigned int Y = dim > 1 ? 1 : 0;
         const double x = disc.position[i][0] - prm.crack_origin[0],
-                     y = dim > 1 ? disc.position[i][dim > 1 ? 1 : 0] - prm.crack_origin[dim > 1 ? 1 : 0] : 0.;
+                     y = disc.position[i][Y] - prm.crack_origin[Y];
         s[4] += V;
         s[5] += V * x;
         s[6] += V * y;

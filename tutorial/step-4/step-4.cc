@@ -27,12 +27,12 @@
 // the tip speed its growth between rows of the CSV.
 //
 // Checks (exit code):
-//  1. Crack angle at the end within 68 +- 8 degrees (the experiment). PD
-//     simulations of this test in the literature report 60-70 degrees at
-//     different resolutions and influence functions (Silling 2003: ~68;
-//     Ha & Bobaru 2010: ~65-70), and the coarse CI lattice (m = 4) changes
-//     the angle by a few degrees: the band is the experiment plus that
-//     spread, not fitted to this code's output.
+//  1. Crack angle at the end within 68 +- 8 degrees: the experiment
+//     ("about 68 degrees") plus the few degrees by which the model choices
+//     (bond-based, nu = 1/4, constant influence function, delta = 4 mm, the
+//     held 16.5 m/s instead of the 32 m/s impact) and a coarse lattice may
+//     move it. The band was fixed before the first run, not fitted to this
+//     code's output; measured: 62.1 (m = 4), 62.5 (m = 12), see doc.md.
 //  2. The mean tip speed over the propagation phase is positive and below
 //     the Rayleigh wave speed c_R = 0.9194 c_s (nu = 1/4), the theoretical
 //     limit of a mode-I crack.
