@@ -400,7 +400,7 @@ namespace
               model + ": delta -> 0 at m = 3 levels off (" + sci(e.front()) + " -> " +
                 sci(e.back()) + ")");
         std::vector<double> em;
-        for (const unsigned int m : {2u, 4u, 8u})
+        for (const unsigned int m : {2u, 4u, 6u})
           {
             em.push_back(trig_error(model, 0.1, m));
             if (root())

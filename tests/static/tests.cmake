@@ -33,5 +33,5 @@ perideal_add_test(NAME static.driver.bad_input
   COMMAND ${CMAKE_CURRENT_LIST_DIR}/../driver/expect_failure.sh "Model/LPS/Critical stretch"
           ${_perideal} ${CMAKE_CURRENT_LIST_DIR}/bad_static.prm LABELS unit)
 # Trigonometric manufactured solution, delta- and m-refinement (reported
-# rates; LPS at m = 8 is a large two-hop matrix).
+# rates; LPS at m = 6 is a large two-hop matrix).
 perideal_add_test(NAME static.trig COMMAND $<TARGET_FILE:static_tests> trig LABELS long)
