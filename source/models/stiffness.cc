@@ -251,7 +251,6 @@ namespace PeriDEAL
 
       std::vector<Tensor<1, dim>> g, h;
       std::vector<Tensor<2, dim>> dev;
-      std::vector<unsigned int>   row(1);
       for (unsigned int j = 0; j < disc.n_owned(); ++j)
         {
           set_family(j);
@@ -294,7 +293,6 @@ namespace PeriDEAL
           });
         }
       matrix.compress(VectorOperation::add);
-      (void)row;
     }
 
     template <int dim>

@@ -119,7 +119,8 @@ namespace
   {
     const double delta = 0.3;
     // Layer delta: the layer nodes have partial families, the general case.
-    StaticMechanicsSolver<dim> s(MPI_COMM_WORLD, parameters<dim>(model, delta, m, 1.));
+    StaticMechanicsSolver<dim> s(MPI_COMM_WORLD,
+                                 parameters<dim>(model, delta, m, 1., dim == 2 ? 1. : 0.6));
     s.setup();
     const auto &disc = s.discretization();
 
@@ -391,14 +392,26 @@ namespace
           if (root())
             std::cout << "  observed delta-order " << std::log(e[k - 1] / e[k]) / std::log(2.)
                       << std::endl;
+        // Measured: at fixed m the error levels off at the quadrature error
+        // of the m = 3 stencil (bond-based 2.3e-2 -> 1.9e-2, LPS 2.2e-2 ->
+        // 1.2e-2): the standard scheme with partial volumes is not
+        // asymptotically compatible. Asserted as measured.
+        check(e.back() > 0.4 * e.front(),
+              model + ": delta -> 0 at m = 3 levels off (" + sci(e.front()) + " -> " +
+                sci(e.back()) + ")");
         std::vector<double> em;
-        for (const unsigned int m : {2u, 4u, 8u})
+        for (const unsigned int m : {2u, 4u, 6u})
           {
             em.push_back(trig_error(model, 0.1, m));
             if (root())
               std::cout << "  " << model << " delta = 0.1 m = " << m << ": max rel. error "
                         << sci(em.back()) << std::endl;
           }
+        // m -> infinity at fixed delta: converges (to the nonlocal solution,
+        // which differs from u by the O(delta^2) model error).
+        check(em.back() < 0.5 * em.front(),
+              model + ": m-refinement at delta = 0.1 reduces the error (" + sci(em.front()) +
+                " -> " + sci(em.back()) + ")");
       }
   }
 
@@ -463,7 +476,8 @@ namespace
   equilibrium_case(const std::string &model)
   {
     const double delta = 0.3;
-    auto         p     = parameters<dim>(model, delta, 3, 2.);
+    // 3D: m = 2 on a smaller box keeps the two-hop LPS matrix small.
+    auto         p     = parameters<dim>(model, delta, dim == 2 ? 3 : 2, 2., dim == 2 ? 1. : 0.6);
     p.layer_displacement = [](const Point<dim> &x) {
       Tensor<1, dim> v;
       v[0] = 1e-2 * x[0] * x[0];
@@ -514,7 +528,7 @@ namespace
   void
   rank_case(const std::string &model, const std::string &solver)
   {
-    auto p = parameters<dim>(model, 0.3, 3, 2.);
+    auto p = parameters<dim>(model, 0.3, dim == 2 ? 3 : 2, 2., dim == 2 ? 1. : 0.6);
     p.solver = solver;
     p.layer_displacement = [](const Point<dim> &x) {
       Tensor<1, dim> v;

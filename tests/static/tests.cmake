@@ -29,3 +29,9 @@ foreach(_case static_plate static_plate_bb)
     LABELS ${_labels} WORKING_DIRECTORY ${_wd})
 endforeach()
 set_tests_properties(static.driver.static_plate PROPERTIES PROCESSORS 2)
+perideal_add_test(NAME static.driver.bad_input
+  COMMAND ${CMAKE_CURRENT_LIST_DIR}/../driver/expect_failure.sh "Model/LPS/Critical stretch"
+          ${_perideal} ${CMAKE_CURRENT_LIST_DIR}/bad_static.prm LABELS unit)
+# Trigonometric manufactured solution, delta- and m-refinement (reported
+# rates; LPS at m = 6 is a large two-hop matrix).
+perideal_add_test(NAME static.trig COMMAND $<TARGET_FILE:static_tests> trig LABELS long)

@@ -159,9 +159,9 @@ namespace PeriDEAL
   };
 
   /**
-   * The driver's `Problem = static mechanics`: parse the parameters, write
-   * the used parameter file is the caller's job; set up, solve, write VTU
-   * and summary.txt, print a one-line result on rank 0. Throws
+   * The driver's `Problem = static mechanics`: parse the parameters, set
+   * up, solve, write VTU and summary.txt, and print a one-line result on
+   * rank 0 (copying the parameter file is the caller's job). Throws
    * ParameterError for dim = 1.
    */
   template <int dim>
