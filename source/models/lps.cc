@@ -1,5 +1,6 @@
 #include <deal.II/base/mpi.h>
 
+#include <perideal/models/bond_damage.h>
 #include <perideal/base/exceptions.h>
 #include <perideal/models/lps.h>
 
@@ -237,30 +238,14 @@ namespace PeriDEAL
   std::uint64_t
   LinearizedLPSOperator<dim>::n_broken_bonds() const
   {
-    std::uint64_t n = 0;
-    for (const auto f : broken_flag)
-      n += f;
-    return Utilities::MPI::sum(n, disc.get_mpi_communicator());
+    return BondDamage::count_broken(broken_flag, disc.get_mpi_communicator());
   }
 
   template <int dim>
   void
   LinearizedLPSOperator<dim>::damage(Vector &phi) const
   {
-    const auto &nb = disc.neighborhood;
-    for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      {
-        const std::uint64_t begin = nb.row_start[i];
-        const double       *w     = nb.bond_weight.data() + nb.table_start[i];
-        double              all = 0., intact = 0.;
-        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
-          {
-            all += w[b - begin];
-            if (!broken_flag[b])
-              intact += w[b - begin];
-          }
-        phi.local_element(i) = all > 0. ? 1. - intact / all : 0.;
-      }
+    BondDamage::compute_damage(disc, broken_flag, phi);
   }
 
   template class LinearizedLPSOperator<2>;

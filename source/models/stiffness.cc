@@ -204,7 +204,7 @@ namespace PeriDEAL
               const Tensor<1, dim> xi = bond_vector(disc, i, nb.col[b]);
               const double         r  = xi.norm();
               const Tensor<2, dim> C =
-                coef[nb.table_start[i] + (b - begin)] / (r * r * r) * outer_product(xi, xi);
+                coef[nb.table_start[i] + (b - begin)] / (r * r) * outer_product(xi, xi);
               blocks[0] += C;
               blocks[1 + b - begin] -= C;
             }

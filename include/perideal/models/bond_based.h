@@ -143,8 +143,9 @@ namespace PeriDEAL
       return linearized;
     }
     /**
-     * c omega(min(|xi|, delta)) beta V_j per entry of the Neighborhood bond
-     * tables (row i uses the slice starting at table_start[i]).
+     * c omega(min(|xi|, delta)) beta V_j / |xi| per entry of the
+     * Neighborhood bond tables (row i uses the slice starting at
+     * table_start[i]); the division by the bond length is the force loop's.
      */
     const std::vector<double> &
     bond_coefficients() const
