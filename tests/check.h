@@ -28,6 +28,16 @@ namespace PeriDEALTests
     return dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   }
 
+  /** x in scientific notation with 4 significant digits, for check messages. */
+  inline std::string
+  sci(const double x)
+  {
+    std::ostringstream s;
+    s.precision(3);
+    s << std::scientific << x;
+    return s.str();
+  }
+
   /** Record a check; print on rank 0. */
   inline void
   check(const bool ok, const std::string &what)

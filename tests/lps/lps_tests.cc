@@ -18,15 +18,6 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  std::string
-  sci(const double x)
-  {
-    std::ostringstream s;
-    s.precision(3);
-    s << std::scientific << x;
-    return s.str();
-  }
-
   const double K = 2.1, G = 0.9;
 
   // A ball of radius 2 delta + 2 dx around the origin, a lattice node: the

@@ -18,15 +18,6 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  std::string
-  sci(const double x)
-  {
-    std::ostringstream s;
-    s.precision(3);
-    s << std::scientific << x;
-    return s.str();
-  }
-
   template <int dim>
   std::unique_ptr<Discretization<dim>>
   make_box(const MPI_Comm comm, const double side, const double dx, const double delta)

@@ -32,15 +32,6 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  std::string
-  sci(const double x)
-  {
-    std::ostringstream s;
-    s.precision(3);
-    s << std::scientific << x;
-    return s.str();
-  }
-
   const double K_bulk = 2.1, G_shear = 0.9, E_young = 1.7;
 
   // A rank-independent pseudo-random number in [-1, 1] from a node id.
