@@ -135,7 +135,8 @@ namespace PeriDEAL
   radial_power_integral(const InfluenceFunction omega, const double delta, const double s)
   {
     check_parameter(s > -1., "Kernel exponent", s,
-                    "a kernel whose radial moments int omega r^s dr exist (s > -1)");
+                    "a kernel whose radial moments int omega r^s dr exist: the power "
+                    "s = degree - exponent + dim - 1 (the value shown) must exceed -1");
     const double p = std::pow(delta, s + 1.);
     return omega == InfluenceFunction::constant ? p / (s + 1.) : p / ((s + 1.) * (s + 2.));
   }
