@@ -405,7 +405,8 @@ namespace PeriDEAL
                                  std::to_string(cand.size()) +
                                  " including itself); lower the order or refine the grid");
         // Each auxiliary point takes the nearest unused family node; ties
-        // are broken by position so the choice is rank independent.
+        // are broken by distance to x_i, then by position, so the choice is
+        // symmetric on lattices and rank independent.
         used.assign(cand.size(), 0);
         chosen.clear();
         for (const auto &offset : aux_offsets)
@@ -420,13 +421,19 @@ namespace PeriDEAL
                   bool         better = best < 0 || d < best_d * (1. - 1e-12);
                   if (!better && d <= best_d * (1. + 1e-12))
                     {
-                      const auto &pa = position[cand[c]], &pb = position[cand[best]];
-                      for (int k = 0; k < dim; ++k)
-                        if (pa[k] != pb[k])
-                          {
-                            better = pa[k] < pb[k];
-                            break;
-                          }
+                      // A tie: the node nearer x_i wins (keeps the set
+                      // symmetric on a lattice), then the position.
+                      const auto  &pa = position[cand[c]], &pb = position[cand[best]];
+                      const double ra = pa.distance_square(xi), rb = pb.distance_square(xi);
+                      if (ra < rb * (1. - 1e-12))
+                        better = true;
+                      else if (ra <= rb * (1. + 1e-12))
+                        for (int k = 0; k < dim; ++k)
+                          if (pa[k] != pb[k])
+                            {
+                              better = pa[k] < pb[k];
+                              break;
+                            }
                     }
                   if (better)
                     {
