@@ -284,7 +284,8 @@ namespace Step9
   TransientResult
   run_transient(const int scheme, const bool perturbed, const unsigned int n,
                 const double perturbation, const unsigned int seed, const double dt,
-                const std::vector<double> &report_times, const bool spectrum)
+                const std::vector<double> &report_times, const bool spectrum,
+                const unsigned int n_collocation)
   {
     const double       dx = 1. / n, delta = 5. * dx;
     const unsigned int layer = 5;
@@ -334,7 +335,8 @@ namespace Step9
         kernel.delta    = delta;
         kernel.constant = 1.;
         WlsParameters prm;
-        prm.order = scheme;
+        prm.order         = scheme;
+        prm.n_collocation = n_collocation;
         WlsQuadrature<2> wls(prm, kernel);
         wls.build(pts, fs, f, rows);
         start = wls.row_start;
@@ -416,6 +418,7 @@ namespace Step9
     double              max_wls_change = 0.15;
     bool                e2_spectrum    = false;
     double              e2_check_end   = 1e300;
+    std::vector<unsigned int> e2_nc{29, 49};
     std::string         output = "step-9-output";
 
     static void
@@ -442,6 +445,8 @@ namespace Step9
       prm.declare_entry("Perturbation", "0.35", Patterns::Double(0., 0.5),
                         "Largest node displacement in units of dx.");
       prm.declare_entry("Random seed", "1", Patterns::Integer(0), "");
+      prm.declare_entry("Collocation nodes", "29, 49", Patterns::List(Patterns::Integer(0)),
+                        "n_c of WLS-2 and WLS-4 (Table 3.2: 29, 49).");
       prm.declare_entry("Check end time", "1e300", Patterns::Double(0.),
                         "The checks use the reported times up to this one.");
       prm.declare_entry("Spectrum", "false", Patterns::Bool(),
@@ -479,6 +484,10 @@ namespace Step9
       e2_seed         = prm.get_integer("Random seed");
       e2_spectrum     = prm.get_bool("Spectrum");
       e2_check_end    = prm.get_double("Check end time");
+      const auto nc   = parse_list(prm.get("Collocation nodes"));
+      check_parameter(nc.size() == 2, "E2/Collocation nodes", prm.get("Collocation nodes"),
+                      "two numbers (WLS-2, WLS-4)");
+      e2_nc = {static_cast<unsigned int>(nc[0]), static_cast<unsigned int>(nc[1])};
       max_wls_change  = prm.get_double("Maximum WLS error change");
       check_parameter(!e2_times.empty() && std::is_sorted(e2_times.begin(), e2_times.end()) &&
                         e2_times.front() > 0.,
@@ -637,7 +646,8 @@ main(int argc, char **argv)
         for (const int s : {0, 2, 4})
           e2.push_back(Step9::run_transient(s, pert, par.e2_n, par.e2_perturbation,
                                             par.e2_seed, par.e2_dt, par.e2_times,
-                                            par.e2_spectrum));
+                                            par.e2_spectrum,
+                                            s == 2 ? par.e2_nc[0] : s == 4 ? par.e2_nc[1] : 0));
       std::cout << "\nE2 2D diffusion, dx = 1/" << par.e2_n << ", delta = 5 dx, dt = "
                 << par.e2_dt << ": rel. l2 error (3.79)\n| t | standard | WLS-2 | WLS-4 | "
                 << "standard (pert.) | WLS-2 (pert.) | WLS-4 (pert.) |\n"
