@@ -1,0 +1,8 @@
+perideal_add_test_program(multigrid_tests ${CMAKE_CURRENT_LIST_DIR}/multigrid_tests.cc)
+
+foreach(_t node_counts bad_input consistency)
+  perideal_add_test(NAME multigrid.${_t} COMMAND $<TARGET_FILE:multigrid_tests> ${_t}
+    LABELS unit)
+endforeach()
+perideal_add_test(NAME multigrid.diffusion_rod
+  COMMAND $<TARGET_FILE:multigrid_tests> diffusion_rod LABELS "unit;convergence")
