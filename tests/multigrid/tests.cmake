@@ -6,3 +6,5 @@ foreach(_t node_counts bad_input consistency)
 endforeach()
 perideal_add_test(NAME multigrid.diffusion_rod
   COMMAND $<TARGET_FILE:multigrid_tests> diffusion_rod LABELS "unit;convergence")
+perideal_add_test(NAME multigrid.e5_corrosion_1d
+  COMMAND $<TARGET_FILE:multigrid_tests> e5 LABELS "unit;convergence")
