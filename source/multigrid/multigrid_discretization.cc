@@ -581,6 +581,25 @@ namespace PeriDEAL
       kernel_weight.resize(disc.col.size());
       for (std::size_t b = 0; b < kernel_weight.size(); ++b)
         kernel_weight[b] = kernel(std::min(disc.bond_length[b], p.delta)) * disc.bond_weight[b];
+      if (prm.calibrate)
+        {
+          // discrete second moment of each grid's full stencil vs the continuum
+          std::array<double, 2> factor;
+          for (const unsigned int g : {0u, 1u})
+            {
+              const double h  = g == 0 ? p.coarse_dx : p.fine_dx;
+              double       m2 = 0.;
+              for (const auto &[o, len] : stencil<dim>(h, p.delta, p.partial_volume))
+                m2 += kernel(std::min(len, p.delta)) *
+                      PeriDEAL::Discretization<dim>::volume_factor(len, p.delta, h,
+                                                                   p.partial_volume) *
+                      std::pow(h, dim) * double(o[0] * o[0]) * h * h;
+              factor[g] = kernel.second_moment() / m2;
+            }
+          for (unsigned int i = 0; i < disc.n_active(); ++i)
+            for (unsigned int b = disc.row_start[i]; b < disc.row_start[i + 1]; ++b)
+              kernel_weight[b] *= factor[disc.grid[i]];
+        }
 
       // Gershgorin bound of the (fictitious-expanded) operator with the
       // largest kappa on every bond, min_i 2 / (|L_ii| + R_i). For the
