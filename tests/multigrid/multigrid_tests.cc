@@ -88,6 +88,28 @@ namespace
             " fictitious nodes use 4 corners (" + std::to_string(d2.n_active_coarse) + " + " +
             std::to_string(d2.n_active_fine) + " active)");
     check_close(d2.active_volume(), 17. * 17. * 0.25, 1e-14, "2D active volume");
+
+    MultiGrid::Parameters<3> p3;
+    p3.lower       = Point<3>(-2., -2., -2.);
+    p3.upper       = Point<3>(2., 2., 2.);
+    p3.fine_dx     = 0.25;
+    p3.fine_region = MultiGrid::Region<3>::cylinder(Point<3>(), 1.2, 1.1);
+    const MultiGrid::Discretization<3> d3(p3);
+    // inside the hull of the coarse nodes 8 corners; in the half cells
+    // beyond the last coarse node (|x_k| > 2) the cell is clamped to its face
+    unsigned int n8 = 0, n_inside = 0;
+    for (unsigned int r = 0; r < d3.interp_node.size(); ++r)
+      {
+        const auto &x      = d3.position[d3.interp_node[r]];
+        const bool  inside = std::abs(x[0]) < 2. && std::abs(x[1]) < 2. && std::abs(x[2]) < 2.;
+        n_inside += inside;
+        n8 += inside && d3.interp_start[r + 1] - d3.interp_start[r] == 8;
+      }
+    check(n8 == n_inside && n_inside > 0 && d3.n_active_fine > 0,
+          "3D cylinder: all " + std::to_string(n_inside) + " of " +
+            std::to_string(d3.interp_node.size()) +
+            " fictitious nodes inside the coarse hull use 8 corners");
+    check_close(d3.active_volume(), 9. * 9. * 9. * 0.125, 1e-14, "3D active volume");
   }
 
   void
@@ -220,9 +242,34 @@ namespace
       }
   }
 
+  // odd ratio r = 3: every coarse node coincides with a fine node, whose
+  // value it takes (inverse distance with a zero distance)
+  void
+  odd_ratio()
+  {
+    MultiGrid::Parameters<1> p;
+    p.lower       = Point<1>(-6.);
+    p.upper       = Point<1>(6.);
+    p.fine_dx     = 0.5 / 3.;
+    p.fine_region = MultiGrid::Region<1>::box(Point<1>(-2.3), Point<1>(2.3));
+    const MultiGrid::Discretization<1> d(p);
+    MultiGrid::TransportParameters     t;
+    MultiGrid::TransportSolver<1>      s(d, t);
+    std::vector<double>                v(d.n_nodes());
+    for (unsigned int i = 0; i < d.n_active(); ++i)
+      v[i] = 1. + 0.3 * d.position[i][0];
+    d.update_fictitious(v);
+    double e = 0.;
+    for (unsigned int i = 0; i < d.n_nodes(); ++i)
+      e = std::max(e, std::abs(v[i] - 1. - 0.3 * d.position[i][0]));
+    check(e < 1e-14 && interior_rate(d, s, v) < 1e-11,
+          "1D r = 3: fictitious values and rates exact for a linear field (" + sci(e) + ")");
+  }
+
   void
   consistency()
   {
+    odd_ratio();
     consistency_case<1>(MultiGrid::Interpolation::inverse_distance);
     consistency_case<1>(MultiGrid::Interpolation::multilinear);
     consistency_case<2>(MultiGrid::Interpolation::multilinear);
