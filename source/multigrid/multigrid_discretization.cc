@@ -468,7 +468,46 @@ namespace PeriDEAL
               src.push_back(it->second);
               corner_points.push_back(position[it->second]);
             }
-          corner_weights<dim>(position[k], corner_points, multilinear, prm.interpolation,
+          if (prm.interpolation == Interpolation::nearest_active)
+            {
+              // the 2^dim nearest *active* nodes of the other grid, searched
+              // within 3 cells of the enclosing cell (ties: lower index)
+              const Index<dim> &base = corners[0];
+              const auto       &n    = is_coarse ? nf : nc;
+              std::vector<std::pair<double, unsigned int>> cand;
+              long long total = 1;
+              for (unsigned int d = 0; d < dim; ++d)
+                total *= 8;
+              for (long long c = 0; c < total; ++c)
+                {
+                  Index<dim> j;
+                  long long  rest = c;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      j[d] = base[d] + rest % 8 - 3;
+                      rest /= 8;
+                    }
+                  if (!in_range<dim>(j, n))
+                    continue;
+                  const auto it = other.find(linear<dim>(j, n));
+                  if (it != other.end() && it->second < n_active())
+                    cand.emplace_back(position[k].distance(position[it->second]), it->second);
+                }
+              std::sort(cand.begin(), cand.end());
+              AssertThrow(cand.size() >= (1u << dim), ExcInternalError());
+              cand.resize(1u << dim);
+              src.clear();
+              corner_points.clear();
+              for (const auto &c : cand)
+                {
+                  src.push_back(c.second);
+                  corner_points.push_back(position[c.second]);
+                }
+            }
+          corner_weights<dim>(position[k], corner_points, multilinear,
+                              prm.interpolation == Interpolation::multilinear ?
+                                Interpolation::multilinear :
+                                Interpolation::inverse_distance,
                               is_coarse ? h : H, w);
           interp_node.push_back(k);
           for (unsigned int j = 0; j < src.size(); ++j)

@@ -63,15 +63,24 @@ namespace PeriDEAL
     };
 
     /**
-     * How a fictitious node gets its value from the 2^dim corners of the
-     * cell of the other grid's lattice that contains it.
+     * How a fictitious node gets its value: by default from the 2^dim
+     * corners of the cell of the other grid's lattice that contains it.
      */
     enum class Interpolation
     {
       /** (3.85)-(3.88): weights 1/|x_k - x_j|, normalized. */
       inverse_distance,
       /** d-linear (tensor-product) interpolation: exact for linear fields. */
-      multilinear
+      multilinear,
+      /**
+       * (3.85)-(3.88) read literally: inverse distance over the 2^dim
+       * nearest *active* nodes of the other grid. For a fine fictitious
+       * node next to the interface these all lie on the far side (the
+       * enclosing cell's inner corner is inactive in the coarse grid), so
+       * the value is a convex combination of farther nodes: an O(dx+
+       * |grad C|) error. Kept for comparison.
+       */
+      nearest_active
     };
 
     /**
