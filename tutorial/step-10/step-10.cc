@@ -142,7 +142,7 @@ namespace Step10
     std::string                        name;
     unsigned int                       nodes = 0;
     std::vector<std::array<double, 2>> volume; // (t, V_solid)
-    double vanishing = -1., mass_change = 0., wall = 0.;
+    double vanishing = -1., mass_change = 0., wall = 0., setup = 0.;
     std::vector<std::pair<double, std::vector<std::array<double, 2>>>> profiles;
   };
 
@@ -181,6 +181,7 @@ namespace Step10
     DiffusionSolver<dim> solver(MPI_COMM_WORLD, p);
     solver.setup();
     Run r;
+    r.setup = timer.wall_time();
     r.name          = name;
     r.nodes         = solver.discretization().n_global();
     const double m0 = solver.diagnostics().mass;
@@ -230,6 +231,7 @@ namespace Step10
     MultiGrid::TransportSolver<dim> solver(disc, t);
     solver.set_initial(c0);
     Run r;
+    r.setup = timer.wall_time();
     r.name          = name;
     r.nodes         = disc.n_nodes();
     const double m0 = solver.mass();
@@ -428,14 +430,14 @@ namespace Step10
 
         std::cout << "\n2D disk R = " << R << " in [-" << L << ", " << L
                   << "]^2, fine disk radius " << s.fine_radius << ", dt = " << dt << "\n"
-                  << "| model | nodes | V0 | V(t_end)/V0 | vanishing time | max rel. mass change | wall s |\n"
-                     "|---|---:|---:|---:|---:|---:|---:|\n";
+                  << "| model | nodes | V0 | V(t_end)/V0 | vanishing time | max rel. mass change | wall s | of which setup |\n"
+                     "|---|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const auto &r : runs2)
           std::cout << "| " << r.name << " | " << r.nodes << " | " << r.volume[0][1] << " | "
                     << r.volume.back()[1] / r.volume[0][1] << " | " << r.vanishing << " | "
                     << std::scientific << std::setprecision(1) << r.mass_change
                     << std::defaultfloat << std::setprecision(6) << " | " << std::fixed
-                    << std::setprecision(2) << r.wall << std::defaultfloat
+                    << std::setprecision(2) << r.wall << " | " << r.setup << std::defaultfloat
                     << std::setprecision(6) << " |\n";
         const std::string csv2 = s.output + "/solid_volume_2d.csv";
         write_volumes(csv2, runs2);
