@@ -1,0 +1,720 @@
+// Tests of the multi-grid coupling (dissertation Sect. 3.4, eqs. 3.81-3.90):
+// node sets, interpolation consistency, diffusion against the heat kernel
+// and the uniform-fine model, and the 1D corrosion example E5 (Sect. 3.4.1).
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <deal.II/base/timer.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/base/kernel.h>
+#include <perideal/multigrid/multigrid_discretization.h>
+#include <perideal/time_stepping/diffusion_solver.h>
+
+#include "../check.h"
+
+#include <cmath>
+#include <iostream>
+#include <vector>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  template <int dim>
+  MultiGrid::Parameters<dim>
+  e5_parameters(const bool partial_volume = true, const double exponent = 1.)
+  {
+    MultiGrid::Parameters<dim> p;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        p.lower[d] = -50.;
+        p.upper[d] = 50.;
+      }
+    p.coarse_dx      = 0.5;
+    p.fine_dx        = 0.125;
+    p.delta          = 1.;
+    p.partial_volume = partial_volume;
+    p.exponent       = exponent;
+    p.fine_region    = MultiGrid::Region<dim>::box(Point<dim>(-15.25), Point<dim>(15.25));
+    return p;
+  }
+
+  // E5 node counts: 140 coarse + 244 fine + 20 auxiliary (2 x (m- + m+)),
+  // and the active volumes tile the body once (100.5 = 201 coarse cells).
+  void
+  node_counts()
+  {
+    const MultiGrid::Discretization<1> d(e5_parameters<1>());
+    check(d.n_active_coarse == 140, "coarse active nodes " + std::to_string(d.n_active_coarse) +
+                                      " == 140");
+    check(d.n_active_fine == 244, "fine active nodes " + std::to_string(d.n_active_fine) +
+                                    " == 244");
+    check(d.n_fictitious_coarse == 4 && d.n_fictitious_fine == 16,
+          "fictitious nodes " + std::to_string(d.n_fictitious_coarse) + " coarse + " +
+            std::to_string(d.n_fictitious_fine) + " fine == 2 (m+ + m-) = 4 + 16");
+    check_close(d.active_volume(), 201 * 0.5, 1e-15, "active volume (each cell counted once)");
+    // every fictitious value interpolates between the two bracketing nodes
+    // of the other grid (1D: 2 nodes, weights sum to 1)
+    bool ok = true;
+    for (unsigned int r = 0; r < d.interp_node.size(); ++r)
+      {
+        double s = 0., lo = 1e300, hi = -1e300;
+        for (unsigned int q = d.interp_start[r]; q < d.interp_start[r + 1]; ++q)
+          {
+            s += d.interp_weight[q];
+            lo = std::min(lo, d.position[d.interp_source[q]][0]);
+            hi = std::max(hi, d.position[d.interp_source[q]][0]);
+          }
+        const double x = d.position[d.interp_node[r]][0];
+        ok = ok && std::abs(s - 1.) < 1e-14 && d.interp_start[r + 1] - d.interp_start[r] == 2 &&
+             lo <= x && x <= hi;
+      }
+    check(ok, "1D: each fictitious node interpolates from the 2 bracketing nodes");
+
+    // 2D: 4 corners (3.85)-(3.88), 3D: 8
+    MultiGrid::Parameters<2> p2;
+    p2.lower       = Point<2>(-4., -4.);
+    p2.upper       = Point<2>(4., 4.);
+    p2.fine_region = MultiGrid::Region<2>::ball(Point<2>(), 2.2);
+    const MultiGrid::Discretization<2> d2(p2);
+    unsigned int                       n4 = 0;
+    for (unsigned int r = 0; r < d2.interp_node.size(); ++r)
+      n4 += d2.interp_start[r + 1] - d2.interp_start[r] == 4;
+    check(n4 == d2.interp_node.size(),
+          "2D disk: all " + std::to_string(d2.interp_node.size()) +
+            " fictitious nodes use 4 corners (" + std::to_string(d2.n_active_coarse) + " + " +
+            std::to_string(d2.n_active_fine) + " active)");
+    check_close(d2.active_volume(), 17. * 17. * 0.25, 1e-14, "2D active volume");
+
+    MultiGrid::Parameters<3> p3;
+    p3.lower       = Point<3>(-2., -2., -2.);
+    p3.upper       = Point<3>(2., 2., 2.);
+    p3.fine_dx     = 0.25;
+    p3.fine_region = MultiGrid::Region<3>::cylinder(Point<3>(), 1.2, 1.1);
+    const MultiGrid::Discretization<3> d3(p3);
+    // inside the hull of the coarse nodes 8 corners; in the half cells
+    // beyond the last coarse node (|x_k| > 2) the cell is clamped to its face
+    unsigned int n8 = 0, n_inside = 0;
+    for (unsigned int r = 0; r < d3.interp_node.size(); ++r)
+      {
+        const auto &x      = d3.position[d3.interp_node[r]];
+        const bool  inside = std::abs(x[0]) < 2. && std::abs(x[1]) < 2. && std::abs(x[2]) < 2.;
+        n_inside += inside;
+        n8 += inside && d3.interp_start[r + 1] - d3.interp_start[r] == 8;
+      }
+    check(n8 == n_inside && n_inside > 0 && d3.n_active_fine > 0,
+          "3D cylinder: all " + std::to_string(n_inside) + " of " +
+            std::to_string(d3.interp_node.size()) +
+            " fictitious nodes inside the coarse hull use 8 corners");
+    check_close(d3.active_volume(), 9. * 9. * 9. * 0.125, 1e-14, "3D active volume");
+  }
+
+  void
+  bad_input()
+  {
+    auto expect = [](const std::string &what, const std::string &parameter, auto make) {
+      try
+        {
+          make();
+          check(false, what + ": no exception");
+        }
+      catch (const ParameterError &e)
+        {
+          check(e.parameter == parameter, what + ": " + e.what());
+        }
+    };
+    expect("dx+ not a multiple of dx-", "Multi-grid/Fine grid spacing", [] {
+      auto p    = e5_parameters<1>();
+      p.fine_dx = 0.3;
+      MultiGrid::Discretization<1> d(p);
+    });
+    expect("dx- > dx+", "Multi-grid/Fine grid spacing", [] {
+      auto p    = e5_parameters<1>();
+      p.fine_dx = 1.;
+      MultiGrid::Discretization<1> d(p);
+    });
+    expect("fine region narrower than 2 delta", "Multi-grid/Fine region", [] {
+      auto p        = e5_parameters<1>();
+      p.fine_region = MultiGrid::Region<1>::box(Point<1>(-0.9), Point<1>(0.9));
+      MultiGrid::Discretization<1> d(p);
+    });
+    expect("horizon below dx+", "Multi-grid/Horizon", [] {
+      auto p  = e5_parameters<1>();
+      p.delta = 0.4;
+      MultiGrid::Discretization<1> d(p);
+    });
+    expect("negative radius", "Fine region/Radius",
+           [] { MultiGrid::Region<2>::ball(Point<2>(), -1.); });
+    expect("unstable explicit step", "Time stepping/Time step", [] {
+      MultiGrid::Discretization<1> d(e5_parameters<1>());
+      MultiGrid::TransportParameters t;
+      t.kappa     = 1.;
+      t.time_step = 10.;
+      MultiGrid::TransportSolver<1> s(d, t);
+    });
+    expect("bad scheme", "Time stepping/Scheme", [] {
+      MultiGrid::Discretization<1> d(e5_parameters<1>());
+      MultiGrid::TransportParameters t;
+      t.scheme = "Crank";
+      MultiGrid::TransportSolver<1> s(d, t);
+    });
+  }
+
+  // Max |rate| over active nodes whose horizon stays inside the body (a
+  // linear field is stationary only away from the free nonlocal boundary).
+  template <int dim>
+  double
+  interior_rate(const MultiGrid::Discretization<dim> &d,
+                const MultiGrid::TransportSolver<dim> &s,
+                const std::vector<double>             &v)
+  {
+    std::vector<double> rate;
+    s.apply(v, rate);
+    double m = 0.;
+    for (unsigned int i = 0; i < d.n_active(); ++i)
+      {
+        bool inner = true;
+        for (unsigned int k = 0; k < dim; ++k)
+          inner = inner && d.position[i][k] > d.parameters().lower[k] + 2. &&
+                  d.position[i][k] < d.parameters().upper[k] - 2.;
+        if (inner)
+          m = std::max(m, std::abs(rate[i]));
+      }
+    return m;
+  }
+
+  // (a) Consistency: constants are exact for every interpolation (weights
+  // sum to 1); linear fields are exact for d-linear interpolation in any
+  // dimension and for inverse distance in 1D (2 bracketing nodes: IDW with
+  // power 1 is linear interpolation). 2D inverse distance is not exact for
+  // linear fields; its interface rate is measured and reported.
+  template <int dim>
+  void
+  consistency_case(const MultiGrid::Interpolation scheme)
+  {
+    MultiGrid::Parameters<dim> p;
+    for (unsigned int k = 0; k < dim; ++k)
+      {
+        p.lower[k] = dim == 3 ? -3.5 : -6.;
+        p.upper[k] = -p.lower[k];
+      }
+    p.fine_region   = dim == 1 ? MultiGrid::Region<dim>::box(Point<dim>(-2.3), Point<dim>(2.3)) :
+                                 MultiGrid::Region<dim>::ball(Point<dim>(), dim == 3 ? 1.3 : 2.3);
+    p.interpolation = scheme;
+    if (dim == 3)
+      p.fine_dx = 0.25;
+    const MultiGrid::Discretization<dim> d(p);
+    MultiGrid::TransportParameters       t;
+    t.kappa = 1.;
+    MultiGrid::TransportSolver<dim> s(d, t);
+    const std::string name =
+      std::to_string(dim) + "D " +
+      (scheme == MultiGrid::Interpolation::multilinear ?
+         "multilinear" :
+         (scheme == MultiGrid::Interpolation::nearest_active ? "IDW of nearest active" :
+                                                               "inverse distance"));
+    // uniform: stays uniform through 50 explicit steps
+    s.set_initial([](const Point<dim> &) { return 0.7; });
+    for (unsigned int n = 0; n < 50; ++n)
+      s.advance();
+    double dev = 0.;
+    for (unsigned int i = 0; i < d.n_nodes(); ++i)
+      dev = std::max(dev, std::abs(s.solution()[i] - 0.7));
+    check(dev < 1e-14, name + ": uniform field after 50 steps, max deviation " + sci(dev));
+
+    // linear: zero rate at every interior active node, fine and coarse
+    std::vector<double> v(d.n_nodes());
+    for (unsigned int i = 0; i < d.n_active(); ++i)
+      v[i] = 1. + 0.3 * d.position[i][0] + (dim > 1 ? -0.2 * d.position[i][dim - 1] : 0.);
+    d.update_fictitious(v);
+    const double r   = interior_rate(d, s, v);
+    // scale: kappa sum_j w_ij |xi| |grad| ~ the rate of a unit jump
+    const bool exact = scheme == MultiGrid::Interpolation::multilinear ||
+                       (dim == 1 && scheme == MultiGrid::Interpolation::inverse_distance);
+    if (exact)
+      check(r < 1e-11, name + ": linear field, max interior rate " + sci(r));
+    else
+      {
+        // reported, not a pass condition of the scheme: IDW reproduces
+        // constants only, so a linear field sees an O(dx+) interface error
+        std::cout << "  info  " << name << ": linear field, max interior rate " << sci(r)
+                  << " (exact for constants only)" << std::endl;
+        check(r > 1e-8, name + ": not linear-exact (rate " + sci(r) + " > 0)");
+      }
+  }
+
+  // odd ratio r = 3: every coarse node coincides with a fine node, whose
+  // value it takes (inverse distance with a zero distance)
+  void
+  odd_ratio()
+  {
+    MultiGrid::Parameters<1> p;
+    p.lower       = Point<1>(-6.);
+    p.upper       = Point<1>(6.);
+    p.fine_dx     = 0.5 / 3.;
+    p.fine_region = MultiGrid::Region<1>::box(Point<1>(-2.3), Point<1>(2.3));
+    const MultiGrid::Discretization<1> d(p);
+    MultiGrid::TransportParameters     t;
+    MultiGrid::TransportSolver<1>      s(d, t);
+    std::vector<double>                v(d.n_nodes());
+    for (unsigned int i = 0; i < d.n_active(); ++i)
+      v[i] = 1. + 0.3 * d.position[i][0];
+    d.update_fictitious(v);
+    double e = 0.;
+    for (unsigned int i = 0; i < d.n_nodes(); ++i)
+      e = std::max(e, std::abs(v[i] - 1. - 0.3 * d.position[i][0]));
+    check(e < 1e-14 && interior_rate(d, s, v) < 1e-11,
+          "1D r = 3: fictitious values and rates exact for a linear field (" + sci(e) + ")");
+  }
+
+  void
+  consistency()
+  {
+    odd_ratio();
+    consistency_case<1>(MultiGrid::Interpolation::inverse_distance);
+    consistency_case<1>(MultiGrid::Interpolation::multilinear);
+    consistency_case<1>(MultiGrid::Interpolation::nearest_active);
+    consistency_case<2>(MultiGrid::Interpolation::multilinear);
+    consistency_case<2>(MultiGrid::Interpolation::inverse_distance);
+    consistency_case<2>(MultiGrid::Interpolation::nearest_active);
+    consistency_case<3>(MultiGrid::Interpolation::multilinear);
+  }
+
+  template <int dim>
+  DiffusionRunParameters<dim>
+  uniform_parameters(const std::string &text)
+  {
+    ParameterHandler prm;
+    DiffusionRunParameters<dim>::declare_parameters(prm);
+    prm.parse_input_from_string(text);
+    DiffusionRunParameters<dim> p;
+    p.parse_parameters(prm);
+    p.output_directory = "uniform_output";
+    return p;
+  }
+
+  // Linear interpolation of a uniform 1D solver's field at x.
+  double
+  sample_uniform(const DiffusionSolver<1> &s, const double x)
+  {
+    const auto  &disc = s.discretization();
+    double       best_l = -1e300, best_r = 1e300, cl = 0., cr = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double xi = disc.position[i][0];
+        if (xi <= x && xi > best_l)
+          best_l = xi, cl = s.solution().local_element(i);
+        if (xi >= x && xi < best_r)
+          best_r = xi, cr = s.solution().local_element(i);
+      }
+    if (best_r - best_l < 1e-12)
+      return cl;
+    return cl + (cr - cl) * (x - best_l) / (best_r - best_l);
+  }
+
+  // (b) 1D rod, linear PD diffusion D = 1 (J_1, omega_0, partial volumes),
+  // Gaussian C0 = exp(-x^2 / (2 s0^2)), s0 = 2, on [-30, 30] with a fine
+  // region [-5, 5] (dx- = 0.125) and dx+ = 0.5 (m+ = 2), delta = 1, to
+  // t = 4. Against the heat kernel C = s0/s exp(-x^2/(2 s^2)), s^2 = s0^2
+  // + 2 D t, and against the uniform-fine model (existing DiffusionSolver,
+  // dx = 0.125). Both the multi-grid and the uniform models carry the same
+  // PD modelling error O((delta/s)^2) against the local solution, so the
+  // multi-grid's error must be within 10% of the uniform-fine model's
+  // error, and its distance to the uniform-fine solution must be well below
+  // that modelling error (the coupling adds no O(1) interface error).
+  void
+  diffusion_rod()
+  {
+    const double s0 = 2., D = 1., t_end = 4.;
+    auto         exact = [&](const double x, const double t) {
+      const double s2 = s0 * s0 + 2. * D * t;
+      return s0 / std::sqrt(s2) * std::exp(-x * x / (2. * s2));
+    };
+    MultiGrid::Parameters<1> p;
+    p.lower       = Point<1>(-30.);
+    p.upper       = Point<1>(30.);
+    p.fine_region = MultiGrid::Region<1>::box(Point<1>(-5.), Point<1>(5.));
+    const MultiGrid::Discretization<1> d(p);
+    ScalarKernel                        k;
+    k.dim      = 1;
+    k.exponent = 1.;
+    k.delta    = 1.;
+    const double kappa = k.micro_constant_for(D);
+
+    const double dt = 0.005;
+    auto run_uniform = [&](const double dx) {
+      auto up = uniform_parameters<1>(R"(
+subsection Geometry
+  set Domain = box
+  set Lower corner = -30
+  set Upper corner = 30
+end
+subsection Discretization
+  set Grid spacing = )" + std::to_string(dx) + R"(
+  set Horizon = 1
+  set Volume constraint layer = 0
+end
+subsection Model
+  set Type = diffusion
+  set Kernel exponent = 1
+  set Diffusivity = 1
+  set Initial condition = exp(-x*x/8)
+end
+subsection Time stepping
+  set Time step = )" + std::to_string(dt) + R"(
+  set End time = 4
+end
+)");
+      auto s = std::make_unique<DiffusionSolver<1>>(MPI_COMM_WORLD, up);
+      s->setup();
+      while (s->step() < s->n_steps())
+        s->advance();
+      return s;
+    };
+    const auto fine   = run_uniform(0.125);
+    const auto coarse = run_uniform(0.5);
+
+    for (const bool conservative : {false, true})
+    for (const std::string scheme : {"forward Euler", "backward Euler"})
+      {
+        MultiGrid::TransportParameters t;
+        t.conservative = conservative;
+        t.kappa     = kappa;
+        t.time_step = dt;
+        t.scheme    = scheme;
+        MultiGrid::TransportSolver<1> s(d, t);
+        s.set_initial([&](const Point<1> &x) { return exact(x[0], 0.); });
+        const double m0 = s.mass();
+        while (s.time() < t_end - 1e-9)
+          s.advance();
+        double e_mg = 0., e_mg_fine = 0., norm = 0.;
+        for (unsigned int i = 0; i < d.n_active(); ++i)
+          {
+            const double x = d.position[i][0];
+            e_mg           = std::max(e_mg, std::abs(s.solution()[i] - exact(x, t_end)));
+            e_mg_fine = std::max(e_mg_fine, std::abs(s.solution()[i] - sample_uniform(*fine, x)));
+            norm      = std::max(norm, exact(x, t_end));
+          }
+        double e_fine = 0., e_coarse = 0.;
+        for (unsigned int i = 0; i < fine->discretization().n_owned(); ++i)
+          e_fine = std::max(e_fine, std::abs(fine->solution().local_element(i) -
+                                             exact(fine->discretization().position[i][0], t_end)));
+        for (unsigned int i = 0; i < coarse->discretization().n_owned(); ++i)
+          e_coarse =
+            std::max(e_coarse, std::abs(coarse->solution().local_element(i) -
+                                        exact(coarse->discretization().position[i][0], t_end)));
+        std::cout << "  info  " << (conservative ? "conservative " : "") << scheme << ": max error vs heat kernel: multi-grid "
+                  << sci(e_mg / norm) << ", uniform fine " << sci(e_fine / norm)
+                  << ", uniform coarse " << sci(e_coarse / norm)
+                  << "; multi-grid vs uniform fine " << sci(e_mg_fine / norm)
+                  << "; relative mass change " << sci(std::abs(s.mass() - m0) / m0)
+                  << std::endl;
+        if (!conservative)
+          {
+            // The outer region is coarse, so the multi-grid error lies
+            // between the two uniform models'; 1.3 x e_fine leaves room for
+            // backward Euler's extra O(dt) error (e_coarse = 1.25 e_fine).
+            check(e_mg <= 1.3 * e_fine,
+                  scheme + ": multi-grid error vs heat kernel " + sci(e_mg / norm) +
+                    " <= 1.3 x uniform-fine error " + sci(e_fine / norm));
+            // (3.86)/(3.88) are linear interpolations in 1D: the fictitious
+            // values carry an O(dx+^2 C'') error, and the two grids see
+            // different interface fluxes; estimate (dx+^2/8) |C''| (D/delta)
+            // x 2 interfaces x t ~ 1e-2 of the mass; measured 2.4e-3.
+            check(std::abs(s.mass() - m0) / m0 < 5e-3,
+                  scheme + ": interpolation coupling, relative mass change " +
+                    sci(std::abs(s.mass() - m0) / m0) + " < 5e-3 (not conservative)");
+          }
+        else
+          {
+            check(std::abs(s.mass() - m0) / m0 < 1e-12,
+                  scheme + ": conservative coupling, relative mass change " +
+                    sci(std::abs(s.mass() - m0) / m0) + " < 1e-12");
+            // the transposed flux is only constant-consistent at the coarse
+            // interface nodes: O(dx+) local error, measured 3.4 x e_fine
+            check(e_mg <= 4. * e_fine,
+                  scheme + ": conservative multi-grid error " + sci(e_mg / norm) +
+                    " <= 4 x uniform-fine error " + sci(e_fine / norm));
+          }
+      }
+  }
+
+  // 2D diffusion of a Gaussian through a circular grid interface: the
+  // mass change of the dissertation coupling comes from the different
+  // effective diffusivities of the two grids (discrete second moments
+  // 1.097 D at m+ = 2 and 1.013 D at m- = 4 with partial volumes), so
+  // calibrating both kernels to the continuum moment must reduce it (by
+  // > 5x with d-linear interpolation; the remainder is the O(dx+^2)
+  // interpolation error), and the conservative coupling removes it.
+  void
+  interface_flux_2d()
+  {
+    MultiGrid::Parameters<2> p;
+    p.lower       = Point<2>(-6., -6.);
+    p.upper       = Point<2>(6., 6.);
+    p.fine_region = MultiGrid::Region<2>::ball(Point<2>(), 2.5);
+    ScalarKernel k;
+    k.dim      = 2;
+    k.exponent = 1.;
+    const double kappa = k.micro_constant_for(1.);
+    auto drift = [&](const MultiGrid::Interpolation interpolation, const bool calibrate,
+                     const bool conservative) {
+      p.interpolation = interpolation;
+      const MultiGrid::Discretization<2> d(p);
+      MultiGrid::TransportParameters     t;
+      t.kappa        = kappa;
+      t.calibrate    = calibrate;
+      t.conservative = conservative;
+      MultiGrid::TransportSolver<2> s(d, t);
+      s.set_initial([](const Point<2> &x) { return std::exp(-x.norm_square() / 2.); });
+      const double m0 = s.mass();
+      while (s.time() < 2.)
+        s.advance();
+      return std::abs(s.mass() - m0) / m0;
+    };
+    const double idw = drift(MultiGrid::Interpolation::inverse_distance, false, false),
+                 idw_cal = drift(MultiGrid::Interpolation::inverse_distance, true, false),
+                 ml = drift(MultiGrid::Interpolation::multilinear, false, false),
+                 ml_cal = drift(MultiGrid::Interpolation::multilinear, true, false),
+                 cons = drift(MultiGrid::Interpolation::inverse_distance, false, true);
+    std::cout << "  info  relative mass change at t = 2: IDW " << sci(idw) << ", IDW calibrated "
+              << sci(idw_cal) << ", multilinear " << sci(ml) << ", multilinear calibrated "
+              << sci(ml_cal) << ", conservative " << sci(cons) << std::endl;
+    check(ml_cal < 0.2 * ml, "calibrated kernels reduce the drift of d-linear coupling > 5x");
+    check(idw_cal < idw, "calibrated kernels reduce the drift of IDW coupling");
+    check(cons < 1e-13, "conservative coupling: mass to round-off");
+  }
+
+  /** Solid-volume history V(t_n) and the vanishing time of one E5 model. */
+  struct CorrosionRun
+  {
+    std::vector<double> volume;
+    double              vanishing = -1., max_mass_change = 0., wall = 0.;
+    unsigned int        nodes = 0;
+  };
+
+  constexpr double e5_end = 120.;
+
+  // E5 on a uniform grid with the existing DiffusionSolver (Coarse, Fine).
+  CorrosionRun
+  e5_uniform(const double dx, const bool partial_volume, const double q,
+             const bool cell_centered = false)
+  {
+    auto up = uniform_parameters<1>(R"(
+subsection Geometry
+  set Domain = box
+  set Lower corner = -50
+  set Upper corner = 50
+end
+subsection Discretization
+  set Grid spacing = )" + std::to_string(dx) + R"(
+  set Horizon = 1
+  set Partial volume = )" + (partial_volume ? "true" : "false") + R"(
+  set Volume constraint layer = 0
+  set Lattice = )" + (cell_centered ? "cell centered" : "vertex") + R"(
+end
+subsection Model
+  set Type = corrosion
+  set Kernel exponent = )" + std::to_string(q) + R"(
+  set Initial condition = (x >= -5) * (x <= 5)
+  subsection Corrosion
+    set Liquid micro-diffusivity = 2
+    set Interface micro-diffusivity = 0.1
+    set Saturation concentration = 0.85
+  end
+end
+subsection Time stepping
+  set Time step = 0.025
+  set End time = )" + std::to_string(e5_end) + R"(
+end
+)");
+    Timer              timer;
+    DiffusionSolver<1> s(MPI_COMM_WORLD, up);
+    s.setup();
+    CorrosionRun r;
+    r.nodes         = s.discretization().n_global();
+    const double m0 = s.diagnostics().mass;
+    r.volume.push_back(s.diagnostics().solid_volume);
+    while (s.step() < s.n_steps() && r.vanishing < 0.)
+      {
+        s.advance();
+        const auto d = s.diagnostics();
+        r.volume.push_back(d.solid_volume);
+        r.max_mass_change = std::max(r.max_mass_change, std::abs(d.mass - m0) / m0);
+        if (d.solid_volume == 0.)
+          r.vanishing = s.time();
+      }
+    r.wall = timer.wall_time();
+    return r;
+  }
+
+  CorrosionRun
+  e5_multigrid(const bool partial_volume, const double q, const bool conservative,
+               const std::string             &scheme = "forward Euler",
+               const MultiGrid::Interpolation interpolation =
+                 MultiGrid::Interpolation::inverse_distance)
+  {
+    Timer                      timer;
+    MultiGrid::Parameters<1>   p = e5_parameters<1>(partial_volume, q);
+    p.interpolation              = interpolation;
+    const MultiGrid::Discretization<1> d(p);
+    MultiGrid::TransportParameters     t;
+    t.corrosion       = true;
+    t.kappa_liquid    = 2.;
+    t.kappa_interface = 0.1;
+    t.saturation      = 0.85;
+    t.time_step       = 0.025;
+    t.conservative    = conservative;
+    t.scheme          = scheme;
+    MultiGrid::TransportSolver<1> s(d, t);
+    s.set_initial([](const Point<1> &x) { return std::abs(x[0]) <= 5. ? 1. : 0.; });
+    CorrosionRun r;
+    r.nodes         = d.n_nodes();
+    const double m0 = s.mass();
+    r.volume.push_back(s.solid_volume());
+    while (s.time() < e5_end - 1e-9 && r.vanishing < 0.)
+      {
+        s.advance();
+        r.volume.push_back(s.solid_volume());
+        r.max_mass_change = std::max(r.max_mass_change, std::abs(s.mass() - m0) / m0);
+        if (s.solid_volume() == 0.)
+          r.vanishing = s.time();
+      }
+    r.wall = timer.wall_time();
+    return r;
+  }
+
+  // max_n |V_a(t_n) - V_b(t_n)| / V_b(0), the shorter history padded with 0
+  double
+  history_distance(const CorrosionRun &a, const CorrosionRun &b)
+  {
+    double m = 0.;
+    for (std::size_t n = 0; n < std::max(a.volume.size(), b.volume.size()); ++n)
+      m = std::max(m, std::abs((n < a.volume.size() ? a.volume[n] : 0.) -
+                               (n < b.volume.size() ? b.volume[n] : 0.)));
+    return m / b.volume[0];
+  }
+
+  // (c) E5, dissertation Sect. 3.4.1: 1D corrosion on [-50, 50], solid
+  // [-5, 5], multi-grid fine (-15.25, 15.25) at dx- = 0.125, dx+ = 0.5,
+  // forward Euler dt = 0.025. The source does not print its kernel; we run
+  // the four variants J_q (q = 1, 0; omega_0) with and without partial
+  // volumes (tutorial step-2 found that the Coarse/Fine order depends on
+  // them). References: the uniform Fine model of the source (vertex
+  // lattice, 801 nodes; 81 solid nodes, V0 = 10.125), the uniform
+  // cell-centred Fine model (800 nodes; the multi-grid's fine nodes are cell
+  // centred, 80 solid nodes, V0 = 10.0) and the uniform Coarse model (201),
+  // all with the existing DiffusionSolver.
+  void
+  e5()
+  {
+    std::cout << "  kernel | beta | coupling | t_vanish Coarse | Fine | Fine cc | Multi-grid | "
+                 "hist. dist. Fine | hist. dist. Fine cc | max rel. mass change"
+              << std::endl;
+    for (const double q : {1., 0.})
+      for (const bool pv : {true, false})
+        {
+          const auto coarse = e5_uniform(0.5, pv, q), fine = e5_uniform(0.125, pv, q),
+                     fine_cc = e5_uniform(0.125, pv, q, true);
+          const std::string name =
+            "J_" + std::to_string(int(q)) + (pv ? " partial volume" : " beta = 1");
+          check(coarse.nodes == 201 && fine.nodes == 801 && fine_cc.nodes == 800,
+                name + ": uniform node counts 201, 801, 800");
+          for (const bool cons : {false, true})
+            {
+              const auto mg = e5_multigrid(pv, q, cons);
+              std::cout << "  " << name << " | " << (cons ? "conservative" : "interpolation")
+                        << " | " << coarse.vanishing << " | " << fine.vanishing << " | "
+                        << fine_cc.vanishing << " | " << mg.vanishing << " | "
+                        << sci(history_distance(mg, fine)) << " | "
+                        << sci(history_distance(mg, fine_cc)) << " | "
+                        << sci(mg.max_mass_change) << std::endl;
+              const std::string what = name + (cons ? ", conservative: " : ", interpolation: ");
+              check(mg.nodes == 404, what + "404 nodes (140 + 244 + 20)");
+              check(mg.vanishing > 0. && fine.vanishing > 0. && coarse.vanishing > 0.,
+                    what + "all solids vanish before t = " + std::to_string(e5_end));
+              // Same solid geometry and the same fine lattice around the
+              // solid: the solid volume must follow the cell-centred Fine
+              // model to within one fine node volume at every step (an
+              // interface error would move the phase front).
+              check(history_distance(mg, fine_cc) <= 0.125 / 10. + 1e-14,
+                    what + "solid-volume history vs uniform cell-centred Fine " +
+                      sci(history_distance(mg, fine_cc)) + " <= one node volume / V0");
+              // Against the source's Fine model: its solid starts 1.25%
+              // larger (81 vs 80 nodes), which alone shifts the vanishing
+              // time by ~1-2%; tolerance 3%.
+              check(std::abs(mg.vanishing - fine.vanishing) <= 0.03 * fine.vanishing,
+                    what + "vanishing time " + std::to_string(mg.vanishing) +
+                      " within 3% of Fine (801 nodes) " + std::to_string(fine.vanishing));
+              if (cons)
+                check(mg.max_mass_change < 1e-13,
+                      what + "max relative mass change " + sci(mg.max_mass_change) +
+                        " < 1e-13 (round-off)");
+              else
+                // reported: (3.81)-(3.88) give the two grids different
+                // interface fluxes, so the total mass drifts (largest
+                // without partial volumes, whose coarse and fine second
+                // moments differ); bound from the measured 1.9e-2
+                check(mg.max_mass_change < 3e-2,
+                      what + "max relative mass change " + sci(mg.max_mass_change) +
+                        " < 3e-2 (the dissertation coupling is not conservative)");
+              // Multi-grid ~ Fine, where Coarse and Fine differ noticeably
+              if (std::abs(coarse.vanishing - fine.vanishing) > 0.05 * fine.vanishing)
+                check(std::abs(mg.vanishing - fine.vanishing) <
+                        std::abs(coarse.vanishing - fine.vanishing),
+                      what + "Multi-grid closer to Fine than Coarse");
+            }
+          // The source's Fig. 3.23: Coarse vanishes first. Reproduced without
+          // partial volumes; with them (J_1) the order is reversed, as in
+          // tutorial step-2 (J_0 with them: equal to one time step).
+          if (!pv)
+            check(coarse.vanishing < e5_multigrid(pv, q, false).vanishing &&
+                    coarse.vanishing < fine.vanishing,
+                  name + ": Coarse vanishes first (" + std::to_string(coarse.vanishing) +
+                    " < Fine " + std::to_string(fine.vanishing) + "), as in Fig. 3.23");
+          else if (q == 1.)
+            check(coarse.vanishing > fine.vanishing,
+                  name + ": Coarse vanishes after Fine (" + std::to_string(coarse.vanishing) +
+                    " > " + std::to_string(fine.vanishing) + "): Fig. 3.23 not reproduced");
+        }
+
+    // (3.85)-(3.88) read as "the nearest active nodes": for E5 the
+    // interface is far from the solid, so only the mass balance shows it
+    {
+      const auto fine_cc = e5_uniform(0.125, true, 1., true);
+      const auto na      = e5_multigrid(true, 1., false, "forward Euler",
+                                   MultiGrid::Interpolation::nearest_active);
+      std::cout << "  info  J_1 partial volume, IDW of the nearest active nodes: vanishing "
+                << na.vanishing << ", hist. dist. Fine cc " << sci(history_distance(na, fine_cc))
+                << ", max rel. mass change " << sci(na.max_mass_change) << std::endl;
+      check(history_distance(na, fine_cc) <= 0.125 / 10. + 1e-14,
+            "nearest-active IDW: solid history within one node volume of Fine cc");
+    }
+
+    // backward Euler (3.89)-(3.90) against forward Euler: same vanishing time
+    // to within 3 steps (the first-order schemes differ by O(dt))
+    const auto fe = e5_multigrid(true, 1., false), be = e5_multigrid(true, 1., false,
+                                                                       "backward Euler");
+    const auto bec = e5_multigrid(true, 1., true, "backward Euler");
+    check(std::abs(fe.vanishing - be.vanishing) <= 3 * 0.025 + 1e-9,
+          "backward Euler vanishing time " + std::to_string(be.vanishing) +
+            " within 3 steps of forward Euler " + std::to_string(fe.vanishing));
+    check(bec.max_mass_change < 1e-12,
+          "conservative backward Euler: max relative mass change " + sci(bec.max_mass_change));
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv,
+             {{"node_counts", node_counts},
+              {"bad_input", bad_input},
+              {"consistency", consistency},
+              {"diffusion_rod", diffusion_rod},
+              {"interface_flux_2d", interface_flux_2d},
+              {"e5", e5}});
+}

@@ -1,0 +1,13 @@
+perideal_add_test_program(multigrid_tests ${CMAKE_CURRENT_LIST_DIR}/multigrid_tests.cc)
+
+foreach(_t node_counts bad_input consistency interface_flux_2d)
+  perideal_add_test(NAME multigrid.${_t} COMMAND $<TARGET_FILE:multigrid_tests> ${_t}
+    LABELS unit)
+endforeach()
+perideal_add_test(NAME multigrid.diffusion_rod
+  COMMAND $<TARGET_FILE:multigrid_tests> diffusion_rod LABELS "unit;convergence")
+perideal_add_test(NAME multigrid.e5_corrosion_1d
+  COMMAND $<TARGET_FILE:multigrid_tests> e5 LABELS "unit;convergence")
+perideal_add_test(NAME tutorial.step-10
+  COMMAND $<TARGET_FILE:step-10> ${CMAKE_SOURCE_DIR}/tutorial/step-10/step-10.prm
+  LABELS tutorial TIMEOUT 600)
