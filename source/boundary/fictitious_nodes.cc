@@ -1,6 +1,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
 
+#include <deal.II/lac/lapack_full_matrix.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/trilinos_precondition.h>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <limits>
 #include <map>
 
@@ -98,7 +100,7 @@ namespace PeriDEAL
                                                  const std::vector<Crack>       &cracks,
                                                  const FictitiousNodeParameters &parameters)
       : comm(comm)
-      , domain(domain)
+      , domain(&domain)
       , cracks(cracks)
       , prm(parameters)
     {
@@ -212,7 +214,7 @@ namespace PeriDEAL
     }
 
     void
-    FictitiousNodeProblem::compute_index_function()
+    FictitiousNodeProblem::compute_index_function(const std::vector<bool> &which)
     {
       // (14) with the discrete full-horizon volume as denominator, so that
       // r = 1 exactly for nodes with a complete, uncut family. The volume
@@ -221,10 +223,13 @@ namespace PeriDEAL
       for (int a = -reach; a <= reach; ++a)
         for (int b = -reach; b <= reach; ++b)
           full += weight(a, b) * (a * a + b * b);
-      index_function.assign(position.size(), 0.);
+      index_function.resize(position.size(), 0.);
       for (unsigned int i = 0; i < position.size(); ++i)
-        if (in_domain[i])
+        if (which.empty() || which[i])
           {
+            index_function[i] = 0.;
+            if (!in_domain[i])
+              continue;
             double inside = 0.;
             for (int a = -reach; a <= reach; ++a)
               for (int b = -reach; b <= reach; ++b)
@@ -276,15 +281,31 @@ namespace PeriDEAL
       return norm > 0. ? g / norm : Tensor<1, 2>();
     }
 
-    void
-    FictitiousNodeProblem::compute_mirror_nodes()
+    unsigned int
+    FictitiousNodeProblem::compute_mirror_nodes(const std::vector<bool> &which)
     {
+      const std::vector<FictitiousNode> old = std::move(fictitious);
+      const std::vector<unsigned int>   old_of_node = std::move(fictitious_of_node),
+                                      old_crack_of_node = std::move(crack_fictitious_of_node);
       fictitious.clear();
       fictitious_of_node.assign(position.size(), numbers::invalid_unsigned_int);
       crack_fictitious_of_node.assign(position.size(), numbers::invalid_unsigned_int);
+      unsigned int n_computed = 0;
       for (unsigned int k = 0; k < position.size(); ++k)
         for (const bool across : {false, true})
           {
+            auto &of_node = across ? crack_fictitious_of_node : fictitious_of_node;
+            if (!which.empty() && !which[k])
+              {
+                // Unaffected by the change: keep the node's role and data.
+                const unsigned int f = (across ? old_crack_of_node : old_of_node)[k];
+                if (f != numbers::invalid_unsigned_int)
+                  {
+                    of_node[k] = fictitious.size();
+                    fictitious.push_back(old[f]);
+                  }
+                continue;
+              }
             // Is k fictitious in this role: a collar node bonded to a domain
             // node, or a domain node with a cut bond?
             if (across != bool(in_domain[k]))
@@ -300,9 +321,11 @@ namespace PeriDEAL
             if (!needed)
               continue;
 
-            (across ? crack_fictitious_of_node : fictitious_of_node)[k] = fictitious.size();
+            of_node[k] = fictitious.size();
             fictitious.push_back(make_mirror(k, across, numbers::invalid_unsigned_int));
+            ++n_computed;
           }
+      return n_computed;
     }
 
     FictitiousNode
@@ -372,10 +395,10 @@ namespace PeriDEAL
           Point<2> a = p, b = p;
           a[d] += h;
           b[d] -= h;
-          grad[d] = (domain.signed_distance(a) - domain.signed_distance(b)) / (2. * h);
+          grad[d] = (domain->signed_distance(a) - domain->signed_distance(b)) / (2. * h);
         }
       const double n = grad.norm();
-      return n > 0. ? Point<2>(p - domain.signed_distance(p) * grad / n) : p;
+      return n > 0. ? Point<2>(p - domain->signed_distance(p) * grad / n) : p;
     }
 
     Point<2>
@@ -385,7 +408,7 @@ namespace PeriDEAL
       for (unsigned int it = 0; it < 60; ++it)
         {
           const double mid = 0.5 * (lo + hi);
-          if (domain.signed_distance(a + mid * (b - a)) <= 0.)
+          if (domain->signed_distance(a + mid * (b - a)) <= 0.)
             lo = mid;
           else
             hi = mid;
@@ -393,37 +416,36 @@ namespace PeriDEAL
       return a + 0.5 * (lo + hi) * (b - a);
     }
 
-    void
-    FictitiousNodeProblem::solve(const BoundaryData &bc)
+    FictitiousNodeProblem::Operator
+    FictitiousNodeProblem::assemble(const BoundaryData &bc) const
     {
-      Timer              timer;
+      Operator           op;
       const unsigned int n_ranks = Utilities::MPI::n_mpi_processes(comm);
       const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
       const unsigned int begin   = std::size_t(n_domain) * rank / n_ranks;
       const unsigned int end     = std::size_t(n_domain) * (rank + 1) / n_ranks;
-      IndexSet           owned(n_domain);
-      owned.add_range(begin, end);
-      owned.compress();
-
-      // Rows in node order; the unknowns of rows begin..end-1.
-      std::vector<std::map<unsigned int, double>> rows(end - begin);
-      std::vector<double>                         rhs(end - begin, 0.);
-      const double                                lambda = prm.taylor_lambda;
+      op.begin                     = begin;
+      op.end                       = end;
+      op.rows.resize(end - begin);
+      const double lambda = prm.taylor_lambda;
 
       for (unsigned int i = 0; i < position.size(); ++i)
         {
           if (!in_domain[i] || unknown[i] < begin || unknown[i] >= end)
             continue;
-          auto   &row = rows[unknown[i] - begin];
-          double &b   = rhs[unknown[i] - begin];
+          auto &row = op.rows[unknown[i] - begin];
           // Each bond adds w (u_eff - u_i) with u_eff = sum c_k u_k + d:
-          // stored as row += w c, b -= w d.
+          // stored as row += w c, b -= w d (d = coefficient * boundary value).
+          const auto b_minus = [&](const Point<2> &p, const double coefficient) {
+            op.data.push_back({unknown[i] - begin, p, -coefficient});
+          };
           const auto naive = [&](const unsigned int j, const double w) {
-            const LocalCondition c = bc(project(position[j]));
+            const Point<2>       p = project(position[j]);
+            const LocalCondition c = bc(p);
             if (c.type == LocalCondition::dirichlet)
               {
                 row[unknown[i]] -= w;
-                b -= w * c.value;
+                b_minus(p, w);
               }
           };
           for (int a = -reach; a <= reach; ++a)
@@ -479,7 +501,7 @@ namespace PeriDEAL
                             // (7): u_G - u_i = (u_b - u_i) min(lambda, 1 + dG/dO).
                             const double s = dO > 0. ? std::min(lambda, 1. + dG / dO) : lambda;
                             row[unknown[i]] -= w * s;
-                            b -= w * s * c.value;
+                            b_minus(xb, w * s);
                           }
                         else
                           {
@@ -488,7 +510,7 @@ namespace PeriDEAL
                             // u_G - u_i = (dO + dG)(g + alpha u_b).
                             const double den = 1. - dO * c.alpha;
                             row[unknown[i]] += w * (dO + dG) * c.alpha / den;
-                            b -= w * (dO + dG) * c.value / den;
+                            b_minus(xb, w * (dO + dG) / den);
                           }
                         break;
                       }
@@ -507,7 +529,7 @@ namespace PeriDEAL
                           {
                             // (10): u_G = 2 u_b - u_m.
                             row[unknown[f.mirror]] -= w;
-                            b -= 2. * w * c.value;
+                            b_minus(f.boundary_point, 2. * w);
                           }
                         else
                           {
@@ -516,12 +538,42 @@ namespace PeriDEAL
                             const double L   = position[j].distance(position[f.mirror]);
                             const double den = 1. - 0.5 * L * c.alpha;
                             row[unknown[f.mirror]] += w * (1. + 0.5 * L * c.alpha) / den;
-                            b -= w * L * c.value / den;
+                            b_minus(f.boundary_point, w * L / den);
                           }
                       }
                   }
               }
         }
+
+      return op;
+    }
+
+    void
+    FictitiousNodeProblem::gather_solution(const std::vector<double> &owned_values, const unsigned int begin)
+    {
+      std::vector<double> values(n_domain, 0.);
+      for (unsigned int u = 0; u < owned_values.size(); ++u)
+        values[begin + u] = owned_values[u];
+      Utilities::MPI::sum(values, comm, values);
+      solution.assign(position.size(), std::numeric_limits<double>::quiet_NaN());
+      for (unsigned int i = 0; i < position.size(); ++i)
+        if (in_domain[i])
+          solution[i] = values[unknown[i]];
+    }
+
+    void
+    FictitiousNodeProblem::solve(const BoundaryData &bc)
+    {
+      Timer          timer;
+      const Operator op = assemble(bc);
+      const auto    &rows = op.rows;
+      const unsigned int begin = op.begin, end = op.end;
+      IndexSet       owned(n_domain);
+      owned.add_range(begin, end);
+      owned.compress();
+      std::vector<double> rhs(end - begin, 0.);
+      for (const auto &d : op.data)
+        rhs[d.row] += d.coefficient * bc(d.point).value;
 
       // Trilinos matrix (rows negated: positive diagonal) and GMRES + AMG.
       TrilinosWrappers::SparsityPattern sp(owned, owned, comm);
@@ -554,15 +606,199 @@ namespace PeriDEAL
       gmres.solve(matrix, x, rhs_vector, amg);
       last_iterations = control.last_step();
 
-      std::vector<double> values(n_domain, 0.);
+      std::vector<double> values(end - begin);
       for (unsigned int u = begin; u < end; ++u)
-        values[u] = x[u];
-      Utilities::MPI::sum(values, comm, values);
-      solution.assign(position.size(), std::numeric_limits<double>::quiet_NaN());
-      for (unsigned int i = 0; i < position.size(); ++i)
-        if (in_domain[i])
-          solution[i] = values[unknown[i]];
+        values[u - begin] = x[u];
+      gather_solution(values, begin);
       last_solve_seconds = timer.wall_time();
+    }
+
+    FnmTimeStepBound
+    FictitiousNodeProblem::gershgorin_time_step(const BoundaryData &bc) const
+    {
+      const Operator   op = assemble(bc);
+      FnmTimeStepBound g;
+      g.time_step         = std::numeric_limits<double>::infinity();
+      unsigned int worst  = numbers::invalid_unsigned_int;
+      for (unsigned int r = 0; r < op.rows.size(); ++r)
+        {
+          double diag = 0., radius = 0.;
+          for (const auto &e : op.rows[r])
+            if (e.first == op.begin + r)
+              diag = -e.second;
+            else
+              radius += std::abs(e.second);
+          if (radius > diag * (1. + 1e-12))
+            g.diagonally_dominant = false;
+          const double bound = 2. / (diag + radius);
+          if (bound < g.time_step)
+            {
+              g.time_step = bound;
+              worst       = op.begin + r;
+            }
+        }
+      // The smallest bound over the ranks, and its row (lowest unknown on ties).
+      const double global = Utilities::MPI::min(g.time_step, comm);
+      const unsigned int row =
+        Utilities::MPI::min(g.time_step == global ? worst : numbers::invalid_unsigned_int, comm);
+      g.time_step           = global;
+      g.diagonally_dominant = Utilities::MPI::min(g.diagonally_dominant ? 1 : 0, comm) == 1;
+      for (unsigned int i = 0; i < position.size(); ++i)
+        if (in_domain[i] && unknown[i] == row)
+          g.node = i;
+      return g;
+    }
+
+    double
+    FictitiousNodeProblem::eigenvalue_time_step(const BoundaryData &bc) const
+    {
+      check_parameter(n_domain <= 4000, "Nodes of the eigenvalue check", n_domain, "at most 4000 (dense)");
+      const Operator      op = assemble(bc);
+      std::vector<double> triplets;
+      for (unsigned int r = 0; r < op.rows.size(); ++r)
+        for (const auto &e : op.rows[r])
+          triplets.insert(triplets.end(), {double(op.begin + r), double(e.first), e.second});
+      LAPACKFullMatrix<double> A(n_domain, n_domain);
+      for (const auto &part : Utilities::MPI::all_gather(comm, triplets))
+        for (unsigned int k = 0; k + 2 < part.size(); k += 3)
+          A(std::size_t(part[k]), std::size_t(part[k + 1])) = part[k + 2];
+      A.compute_eigenvalues();
+      // |1 + dt lambda| <= 1 <=> dt <= -2 Re(lambda) / |lambda|^2.
+      double dt = std::numeric_limits<double>::infinity();
+      for (unsigned int k = 0; k < n_domain; ++k)
+        {
+          const std::complex<double> lambda = A.eigenvalue(k);
+          if (lambda.real() >= 0.)
+            return 0.;
+          dt = std::min(dt, -2. * lambda.real() / std::norm(lambda));
+        }
+      return dt;
+    }
+
+    void
+    FictitiousNodeProblem::advance(const TransientBoundaryData &bc,
+                                   const TransientSource       &source,
+                                   double                      &t,
+                                   const double                 dt,
+                                   const unsigned int           n_steps)
+    {
+      Timer              timer;
+      const double       t0    = t;
+      const BoundaryData bc_t0 = [&](const Point<2> &p) { return bc(p, t0); };
+      const auto         bound = gershgorin_time_step(bc_t0);
+      check_parameter(dt > 0. && dt <= bound.time_step * (1. + 1e-12), "Time step", dt,
+                      "(0, " + std::to_string(bound.time_step) +
+                        "], the Gershgorin bound of the forward Euler iteration matrix of the FNM operator");
+      const Operator op = assemble(bc_t0);
+      IndexSet       owned(n_domain);
+      owned.add_range(op.begin, op.end);
+      owned.compress();
+      TrilinosWrappers::SparsityPattern sp(owned, owned, comm);
+      for (unsigned int r = 0; r < op.rows.size(); ++r)
+        for (const auto &e : op.rows[r])
+          sp.add(op.begin + r, e.first);
+      sp.compress();
+      TrilinosWrappers::SparseMatrix A;
+      A.reinit(sp);
+      for (unsigned int r = 0; r < op.rows.size(); ++r)
+        for (const auto &e : op.rows[r])
+          A.set(op.begin + r, e.first, e.second);
+      A.compress(VectorOperation::insert);
+
+      // The owned rows' nodes (for the source) and the initial values.
+      std::vector<unsigned int> node_of_row(op.end - op.begin);
+      for (unsigned int i = 0; i < position.size(); ++i)
+        if (in_domain[i] && unknown[i] >= op.begin && unknown[i] < op.end)
+          node_of_row[unknown[i] - op.begin] = i;
+      TrilinosWrappers::MPI::Vector u(owned, comm), Au(owned, comm);
+      for (unsigned int r = 0; r < node_of_row.size(); ++r)
+        {
+          const double value = solution.size() == position.size() ? solution[node_of_row[r]] : 0.;
+          check_parameter(std::isfinite(value), "Initial condition", value, "finite values on the domain nodes");
+          u[op.begin + r] = value;
+        }
+      u.compress(VectorOperation::insert);
+
+      std::vector<double> increment(op.rows.size());
+      for (unsigned int step = 0; step < n_steps; ++step)
+        {
+          const double time = t0 + step * dt;
+          A.vmult(Au, u);
+          for (unsigned int r = 0; r < increment.size(); ++r)
+            increment[r] = Au[op.begin + r] + (source ? source(position[node_of_row[r]], time) : 0.);
+          for (const auto &d : op.data)
+            increment[d.row] -= d.coefficient * bc(d.point, time).value;
+          for (unsigned int r = 0; r < increment.size(); ++r)
+            u[op.begin + r] += dt * increment[r];
+          u.compress(VectorOperation::insert);
+        }
+      t = t0 + n_steps * dt;
+      std::vector<double> values(op.end - op.begin);
+      for (unsigned int r = 0; r < values.size(); ++r)
+        values[r] = u[op.begin + r];
+      gather_solution(values, op.begin);
+      last_solve_seconds = timer.wall_time();
+    }
+
+    unsigned int
+    FictitiousNodeProblem::change_domain(const Domain<2> *new_body, const std::vector<Crack> &new_cracks)
+    {
+      std::vector<bool> changed(position.size(), false);
+      if (new_body != nullptr)
+        {
+          check_parameter(new_body->has_signed_distance(), "Geometry", "a domain without signed distance",
+                          "a domain with a signed distance (box, ball, level set)");
+          for (unsigned int i = 0; i < position.size(); ++i)
+            {
+              const bool inside = new_body->inside(position[i]);
+              check_parameter(in_domain[i] || !inside, "Domain change", "a body growing beyond the current one",
+                              "a body inside the current one (nodes can only leave the body)");
+              if (in_domain[i] && !inside)
+                {
+                  in_domain[i] = false;
+                  changed[i]   = true;
+                }
+            }
+          domain = new_body;
+        }
+      for (const auto &c : new_cracks)
+        {
+          check_parameter(c.a.distance(c.b) > 0., "Crack", "a zero-length crack", "segments of positive length");
+          cracks.push_back(c);
+          for (unsigned int i = 0; i < position.size(); ++i)
+            if (distance_to_segment(position[i], c) <= prm.delta + 2. * prm.dx)
+              near_crack[i] = changed[i] = true;
+        }
+
+      // The index function of a node depends on the nodes within one
+      // horizon (reach lattice steps), the normal of a fictitious node on
+      // the index function within another, and the mirror node on the nodes
+      // within 2 steps of the mirror point (at most 2 horizons away):
+      // 2 reach + 3 steps bound the influence of a changed node.
+      const int         radius = 2 * reach + 3;
+      std::vector<bool> affected(position.size(), false);
+      for (unsigned int i = 0; i < position.size(); ++i)
+        if (changed[i])
+          for (int a = -radius; a <= radius; ++a)
+            for (int b = -radius; b <= radius; ++b)
+              {
+                const unsigned int j = node_at(lattice[i][0] + a, lattice[i][1] + b);
+                if (j != numbers::invalid_unsigned_int)
+                  affected[j] = true;
+              }
+
+      // Renumber the unknowns; the solution stays on the remaining nodes.
+      n_domain = 0;
+      for (unsigned int i = 0; i < position.size(); ++i)
+        {
+          unknown[i] = in_domain[i] ? n_domain++ : numbers::invalid_unsigned_int;
+          if (!in_domain[i] && i < solution.size())
+            solution[i] = std::numeric_limits<double>::quiet_NaN();
+        }
+      check_parameter(n_domain > 0, "Domain change", "an empty body", "a body containing nodes");
+
+      compute_index_function(affected);
+      return compute_mirror_nodes(affected);
     }
 
     double

@@ -13,3 +13,8 @@ perideal_add_test(NAME fnm.rank_invariance.np2 NPROCS 2
   COMMAND $<TARGET_FILE:fnm_tests> rank_invariance LABELS mpi)
 perideal_add_test(NAME tutorial.step-12 COMMAND $<TARGET_FILE:step-12> ${CMAKE_CURRENT_LIST_DIR}/step-12-ci.prm
   LABELS "tutorial;convergence" TIMEOUT 600)
+# Transient FNM runs, the Gershgorin time step and domains that change
+# (corrosion, fracture) with locally rebuilt mirror nodes.
+perideal_add_test(NAME fnm.transient COMMAND $<TARGET_FILE:fnm_tests> transient LABELS "unit;convergence")
+perideal_add_test(NAME fnm.transient_ranks.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:fnm_tests> transient_ranks LABELS mpi)

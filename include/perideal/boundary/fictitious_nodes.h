@@ -9,6 +9,7 @@
 
 #include <array>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,32 @@ namespace PeriDEAL
     /** The boundary data: the condition at a point of (or near) the boundary. */
     using BoundaryData = std::function<LocalCondition(const Point<2> &)>;
 
+    /**
+     * Time-dependent boundary data of a transient run: the type and alpha of
+     * the condition at a point must not change in time (they are read when
+     * the operator is assembled); the value may.
+     */
+    using TransientBoundaryData = std::function<LocalCondition(const Point<2> &, const double)>;
+
+    /** A volumetric source f(x, t) of du/dt = L u + f. */
+    using TransientSource = std::function<double(const Point<2> &, const double)>;
+
+    /**
+     * Row-wise Gershgorin bound of forward Euler u <- u + dt (A u - b + f)
+     * with the assembled FNM operator A (as SurfaceNodeRod::GershgorinBound):
+     * every disc of I + dt A lies in [-1, 1] iff
+     * dt <= 2 / (|a_ii| + sum_j |a_ij|) for all rows and every row is
+     * diagonally dominant (sum_j |a_ij| <= |a_ii|, independent of dt).
+     */
+    struct FnmTimeStepBound
+    {
+      double time_step = 0.;
+      /** The domain node of the limiting row. */
+      unsigned int node = 0;
+      /** Every row is diagonally dominant (the discs also stay <= 1). */
+      bool diagonally_dominant = true;
+    };
+
     /** Parameters of a FictitiousNodeProblem. */
     struct FictitiousNodeParameters
     {
@@ -152,6 +179,47 @@ namespace PeriDEAL
       void
       solve(const BoundaryData &bc);
 
+      /**
+       * Transient PD diffusion du/dt = L u + f (unit diffusivity, the steady
+       * operator of solve()) by @p n_steps forward Euler steps of size @p dt
+       * from the current #solution at time @p t (advanced on return). The
+       * FNM operator is assembled once per call from bc(., t); @p dt must not
+       * exceed the Gershgorin bound of that operator (ParameterError).
+       */
+      void
+      advance(const TransientBoundaryData &bc,
+              const TransientSource       &source,
+              double                      &t,
+              const double                 dt,
+              const unsigned int           n_steps);
+
+      /** The Gershgorin bound of forward Euler for the operator with data @p bc. */
+      FnmTimeStepBound
+      gershgorin_time_step(const BoundaryData &bc) const;
+
+      /**
+       * The critical forward Euler step from the eigenvalues of the operator
+       * (dense LAPACK, small problems only): the largest dt with
+       * |1 + dt lambda| <= 1 for all eigenvalues lambda (0 if one has a
+       * positive real part).
+       */
+      double
+      eigenvalue_time_step(const BoundaryData &bc) const;
+
+      /**
+       * The body changes (corrosion / phase change: the nodes outside
+       * @p new_body leave it; fracture: @p new_cracks are added). @p new_body
+       * (nullptr: unchanged) must lie inside the current body and outlive
+       * this object. The nodes leaving the body become fictitious; the index
+       * function (14), the normals (15)-(16) and the mirror nodes are
+       * recomputed for the nodes within two horizons of a change (farther,
+       * none of them can change), and the solution is kept on the remaining
+       * nodes. Returns the number of fictitious nodes whose mirror data were
+       * recomputed.
+       */
+      unsigned int
+      change_domain(const Domain<2> *new_body, const std::vector<Crack> &new_cracks = {});
+
       /** @name Nodes (replicated, sorted by lattice id) */
       /** @{ */
       std::vector<Point<2>> position;
@@ -218,13 +286,39 @@ namespace PeriDEAL
       /** Sect. 3.4 steps 2a-2c for fictitious node k (H^Omega restricted to @p side). */
       FictitiousNode
       make_mirror(const unsigned int k, const bool across, const unsigned int side) const;
+      /** (14) for the nodes flagged in @p which (all if empty). */
       void
-      compute_index_function();
+      compute_index_function(const std::vector<bool> &which = {});
+      /** Sect. 3.4 for the nodes flagged in @p which (all if empty; others keep their data). */
+      unsigned int
+      compute_mirror_nodes(const std::vector<bool> &which = {});
+
+      /**
+       * The assembled operator of the rows [begin, end) of the unknowns:
+       * sum_j rows_ij u_j - b_i, with b_i = sum of coefficient * value(point)
+       * over the data terms of row i (linear in the boundary values, so
+       * time-dependent data only re-evaluate the terms).
+       */
+      struct Operator
+      {
+        unsigned int                                 begin = 0, end = 0;
+        std::vector<std::map<unsigned int, double>> rows;
+        struct DataTerm
+        {
+          unsigned int row;
+          Point<2>     point;
+          double       coefficient;
+        };
+        std::vector<DataTerm> data;
+      };
+      Operator
+      assemble(const BoundaryData &bc) const;
+      /** Scatter the owned unknowns of @p x (all ranks) into #solution. */
       void
-      compute_mirror_nodes();
+      gather_solution(const std::vector<double> &owned_values, const unsigned int begin);
 
       MPI_Comm                 comm;
-      const Domain<2>         &domain;
+      const Domain<2>         *domain;
       std::vector<Crack>       cracks;
       FictitiousNodeParameters prm;
       int                      n_lattice[2] = {0, 0};
