@@ -682,34 +682,46 @@ namespace PeriDEAL
                                    const double                 dt,
                                    const unsigned int           n_steps)
     {
-      Timer              timer;
-      const double       t0    = t;
-      const BoundaryData bc_t0 = [&](const Point<2> &p) { return bc(p, t0); };
-      const auto         bound = gershgorin_time_step(bc_t0);
-      check_parameter(dt > 0. && dt <= bound.time_step * (1. + 1e-12), "Time step", dt,
-                      "(0, " + std::to_string(bound.time_step) +
+      Timer        timer;
+      const double t0 = t;
+      if (!transient)
+        {
+          // Assembled at the first call after construction or a domain
+          // change: the conditions' types and alphas are fixed in time.
+          const BoundaryData bc_t0 = [&](const Point<2> &p) { return bc(p, t0); };
+          transient              = std::make_shared<TransientOperator>();
+          transient->bound       = gershgorin_time_step(bc_t0);
+          transient->op          = assemble(bc_t0);
+          const Operator &op     = transient->op;
+          IndexSet        owned(n_domain);
+          owned.add_range(op.begin, op.end);
+          owned.compress();
+          TrilinosWrappers::SparsityPattern sp(owned, owned, comm);
+          for (unsigned int r = 0; r < op.rows.size(); ++r)
+            for (const auto &e : op.rows[r])
+              sp.add(op.begin + r, e.first);
+          sp.compress();
+          transient->matrix.reinit(sp);
+          for (unsigned int r = 0; r < op.rows.size(); ++r)
+            for (const auto &e : op.rows[r])
+              transient->matrix.set(op.begin + r, e.first, e.second);
+          transient->matrix.compress(VectorOperation::insert);
+          // The owned rows' nodes (for the source and the initial values).
+          transient->node_of_row.resize(op.end - op.begin);
+          for (unsigned int i = 0; i < position.size(); ++i)
+            if (in_domain[i] && unknown[i] >= op.begin && unknown[i] < op.end)
+              transient->node_of_row[unknown[i] - op.begin] = i;
+        }
+      const double time_step = transient->bound.time_step;
+      check_parameter(dt > 0. && dt <= time_step * (1. + 1e-12), "Time step", dt,
+                      "(0, " + std::to_string(time_step) +
                         "], the Gershgorin bound of the forward Euler iteration matrix of the FNM operator");
-      const Operator op = assemble(bc_t0);
-      IndexSet       owned(n_domain);
+      const Operator                       &op          = transient->op;
+      const TrilinosWrappers::SparseMatrix &A           = transient->matrix;
+      const std::vector<unsigned int>      &node_of_row = transient->node_of_row;
+      IndexSet                              owned(n_domain);
       owned.add_range(op.begin, op.end);
       owned.compress();
-      TrilinosWrappers::SparsityPattern sp(owned, owned, comm);
-      for (unsigned int r = 0; r < op.rows.size(); ++r)
-        for (const auto &e : op.rows[r])
-          sp.add(op.begin + r, e.first);
-      sp.compress();
-      TrilinosWrappers::SparseMatrix A;
-      A.reinit(sp);
-      for (unsigned int r = 0; r < op.rows.size(); ++r)
-        for (const auto &e : op.rows[r])
-          A.set(op.begin + r, e.first, e.second);
-      A.compress(VectorOperation::insert);
-
-      // The owned rows' nodes (for the source) and the initial values.
-      std::vector<unsigned int> node_of_row(op.end - op.begin);
-      for (unsigned int i = 0; i < position.size(); ++i)
-        if (in_domain[i] && unknown[i] >= op.begin && unknown[i] < op.end)
-          node_of_row[unknown[i] - op.begin] = i;
       TrilinosWrappers::MPI::Vector u(owned, comm), Au(owned, comm);
       for (unsigned int r = 0; r < node_of_row.size(); ++r)
         {
@@ -761,6 +773,7 @@ namespace PeriDEAL
             }
           domain = new_body;
         }
+      transient.reset();
       for (const auto &c : new_cracks)
         {
           check_parameter(c.a.distance(c.b) > 0., "Crack", "a zero-length crack", "segments of positive length");

@@ -5,11 +5,14 @@
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
 
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+
 #include <perideal/discretization/domain.h>
 
 #include <array>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -183,8 +186,10 @@ namespace PeriDEAL
        * Transient PD diffusion du/dt = L u + f (unit diffusivity, the steady
        * operator of solve()) by @p n_steps forward Euler steps of size @p dt
        * from the current #solution at time @p t (advanced on return). The
-       * FNM operator is assembled once per call from bc(., t); @p dt must not
-       * exceed the Gershgorin bound of that operator (ParameterError).
+       * FNM operator is assembled from bc(., t) at the first call after
+       * construction or change_domain() and reused (the types and alphas of
+       * the conditions must not change in time); @p dt must not exceed the
+       * Gershgorin bound of that operator (ParameterError).
        */
       void
       advance(const TransientBoundaryData &bc,
@@ -313,6 +318,15 @@ namespace PeriDEAL
       };
       Operator
       assemble(const BoundaryData &bc) const;
+      /** The forward Euler operator of advance(), reset by change_domain(). */
+      struct TransientOperator
+      {
+        Operator                       op;
+        FnmTimeStepBound               bound;
+        TrilinosWrappers::SparseMatrix matrix;
+        std::vector<unsigned int>      node_of_row;
+      };
+      std::shared_ptr<TransientOperator> transient;
       /** Scatter the owned unknowns of @p x (all ranks) into #solution. */
       void
       gather_solution(const std::vector<double> &owned_values, const unsigned int begin);
