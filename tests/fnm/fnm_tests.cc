@@ -591,7 +591,7 @@ namespace
 
   /** max |a - b| over the domain nodes of @p fnm. */
   double
-  max_difference(const FictitiousNodeProblem &fnm, const std::vector<double> &a,
+  max_difference(const FictitiousNodeProblem<2> &fnm, const std::vector<double> &a,
                  const std::function<double(const Point<2> &)> &b)
   {
     double d = 0.;
@@ -622,7 +622,7 @@ namespace
         double             t = 0.;
         const double       T = 5.;
         const unsigned int n = std::ceil(T / bound.time_step);
-        fnm.advance([&](const Point<2> &p, double) { return bc(p); }, TransientSource(), t, T / n, n);
+        fnm.advance([&](const Point<2> &p, double) { return bc(p); }, TransientSource<2>(), t, T / n, n);
         const double diff = max_difference(fnm, fnm.solution, [&](const Point<2> &) { return 0.; });
         double       d    = 0.;
         for (unsigned int i = 0; i < fnm.position.size(); ++i)
@@ -661,7 +661,7 @@ namespace
         const auto         bound = fnm.gershgorin_time_step([&](const Point<2> &p) { return bc(p, 0.); });
         double             t     = 0.;
         const unsigned int n     = std::ceil(0.1 / bound.time_step);
-        fnm.advance(bc, TransientSource(), t, 0.1 / n, n);
+        fnm.advance(bc, TransientSource<2>(), t, 0.1 / n, n);
         const double e = max_difference(fnm, fnm.solution, [&](const Point<2> &p) { return exact(p, t); });
         print(to_string(method) + " dx = " + fmt(dx) + ": " + std::to_string(n) + " steps, error at t = 0.1: " +
               fmt(e) + " (" + fmt(fnm.last_solve_seconds) + " s)");
@@ -696,7 +696,7 @@ namespace
           for (unsigned int i = 0; i < fnm.position.size(); ++i)
             fnm.solution[i] = std::sin(37. * i) ;
           double t = 0.;
-          fnm.advance([&](const Point<2> &p, double) { return zero(p); }, TransientSource(), t, dt, 400);
+          fnm.advance([&](const Point<2> &p, double) { return zero(p); }, TransientSource<2>(), t, dt, 400);
           return max_difference(fnm, fnm.solution, [](const Point<2> &) { return 0.; });
         };
         const double after = run(g.time_step);
@@ -721,13 +721,13 @@ namespace
 
   /** Compare the mirror data of two problems on the same lattice, by node position. */
   unsigned int
-  mirror_mismatches(const FictitiousNodeProblem &a, const FictitiousNodeProblem &b, unsigned int &n_compared)
+  mirror_mismatches(const FictitiousNodeProblem<2> &a, const FictitiousNodeProblem<2> &b, unsigned int &n_compared)
   {
-    const auto key = [](const FictitiousNodeProblem &p, const FictitiousNode &f) {
+    const auto key = [](const FictitiousNodeProblem<2> &p, const FictitiousNode<2> &f) {
       return std::make_tuple(std::lround(p.position[f.node][0] / p.parameters().dx * 2.),
                              std::lround(p.position[f.node][1] / p.parameters().dx * 2.), f.across_crack);
     };
-    std::map<std::tuple<long, long, bool>, const FictitiousNode *> of_b;
+    std::map<std::tuple<long, long, bool>, const FictitiousNode<2> *> of_b;
     for (const auto &f : b.fictitious)
       of_b[key(b, f)] = &f;
     unsigned int bad = 0;
@@ -746,7 +746,7 @@ namespace
             ++bad;
             continue;
           }
-        const FictitiousNode &g = *it->second;
+        const FictitiousNode<2> &g = *it->second;
         if ((f.normal - g.normal).norm() > 1e-12 || f.mirror_point.distance(g.mirror_point) > 1e-12 ||
             f.boundary_point.distance(g.boundary_point) > 1e-12 || !same_node(f.closest, g.closest) ||
             !same_node(f.mirror, g.mirror))
@@ -776,7 +776,7 @@ namespace
     fnm.solution.assign(fnm.position.size(), 0.);
     double t = 0.;
     const double dt = fnm.gershgorin_time_step(bc).time_step;
-    fnm.advance(bc_t, TransientSource(), t, dt, 200);
+    fnm.advance(bc_t, TransientSource<2>(), t, dt, 200);
 
     // Corrosion at t = 200 dt.
     const unsigned int n_before  = fnm.fictitious.size();
@@ -799,7 +799,7 @@ namespace
 
     // Continue to the steady state of the new domain.
     const unsigned int n = std::ceil(3. / dt);
-    fnm.advance(bc_t, TransientSource(), t, dt, n);
+    fnm.advance(bc_t, TransientSource<2>(), t, dt, n);
     scratch2.solve(bc);
     double d = 0.;
     for (unsigned int i = 0; i < scratch2.position.size(); ++i)
@@ -829,7 +829,7 @@ namespace
         double t = 0.;
         fnm.advance(bc, [](const Point<2> &p, double) { return p[0]; }, t, 5e-3, 50);
         fnm.change_domain(&corroded, {{Point<2>(-0.6, -0.42), Point<2>(0.2, -0.42)}});
-        fnm.advance(bc, TransientSource(), t, 5e-3, 50);
+        fnm.advance(bc, TransientSource<2>(), t, 5e-3, 50);
         result[k] = fnm.solution;
       }
     double diff = 0.;

@@ -60,7 +60,7 @@ namespace
 {
   /** max |a - b| over the body nodes of @p fnm (b on the same lattice). */
   double
-  max_difference(const FictitiousNodeProblem &fnm, const std::vector<double> &a, const std::vector<double> &b)
+  max_difference(const FictitiousNodeProblem<2> &fnm, const std::vector<double> &a, const std::vector<double> &b)
   {
     double d = 0.;
     for (unsigned int i = 0; i < fnm.position.size(); ++i)
@@ -83,7 +83,7 @@ namespace
     p.delta  = m * dx;
     p.method = FictitiousNodeMethod::mirror;
     // u = y + x/2 (harmonic) on the circle and on the pit surface.
-    const BoundaryData bc = [](const Point<2> &x) { return LocalCondition::make_dirichlet(x[1] + 0.5 * x[0]); };
+    const BoundaryData<2> bc = [](const Point<2> &x) { return LocalCondition::make_dirichlet(x[1] + 0.5 * x[0]); };
 
     // The steady states of the three geometries, from scratch.
     // (The scratch lattices are the same, but hold fewer collar nodes:
@@ -121,7 +121,7 @@ namespace
       while (t < until - 0.5 * dt)
         {
           const unsigned int n = std::min<unsigned int>(chunk, std::lround((until - t) / dt));
-          fnm.advance([&](const Point<2> &x, double) { return bc(x); }, TransientSource(), t, dt, std::max(n, 1u));
+          fnm.advance([&](const Point<2> &x, double) { return bc(x); }, TransientSource<2>(), t, dt, std::max(n, 1u));
           if (root)
             history << t << ' ' << max_difference(fnm, fnm.solution, steady[geometry]) << ' '
                     << max_difference(fnm, fnm.solution, steady.back()) << '\n';

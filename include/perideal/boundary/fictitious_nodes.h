@@ -86,17 +86,20 @@ namespace PeriDEAL
     };
 
     /** The boundary data: the condition at a point of (or near) the boundary. */
-    using BoundaryData = std::function<LocalCondition(const Point<2> &)>;
+    template <int dim>
+    using BoundaryData = std::function<LocalCondition(const Point<dim> &)>;
 
     /**
      * Time-dependent boundary data of a transient run: the type and alpha of
      * the condition at a point must not change in time (they are read when
      * the operator is assembled); the value may.
      */
-    using TransientBoundaryData = std::function<LocalCondition(const Point<2> &, const double)>;
+    template <int dim>
+    using TransientBoundaryData = std::function<LocalCondition(const Point<dim> &, const double)>;
 
     /** A volumetric source f(x, t) of du/dt = L u + f. */
-    using TransientSource = std::function<double(const Point<2> &, const double)>;
+    template <int dim>
+    using TransientSource = std::function<double(const Point<dim> &, const double)>;
 
     /**
      * Row-wise Gershgorin bound of forward Euler u <- u + dt (A u - b + f)
@@ -132,6 +135,7 @@ namespace PeriDEAL
      * One fictitious node of the mirror FNM (Sect. 3.4 of paper 004): a node
      * of the collar Gamma, or a domain node seen from across a crack.
      */
+    template <int dim>
     struct FictitiousNode
     {
       /** Index of the node in FictitiousNodeProblem's node arrays. */
@@ -139,11 +143,11 @@ namespace PeriDEAL
       /** True for a domain node acting as fictitious across a crack. */
       bool across_crack = false;
       /** The generalized normal n_Gamma of (16), pointing into the domain. */
-      Tensor<1, 2> normal;
+      Tensor<1, dim> normal;
       /** The closest domain node x_c on the normal line (invalid: none). */
       unsigned int closest = numbers::invalid_unsigned_int;
       /** The ideal mirror point q and the boundary point x_b (midpoint). */
-      Point<2> mirror_point, boundary_point;
+      Point<dim> mirror_point, boundary_point;
       /** The mirror node x_m: the domain node closest to q (invalid: none). */
       unsigned int mirror = numbers::invalid_unsigned_int;
     };
@@ -166,6 +170,7 @@ namespace PeriDEAL
      * over the ranks as one Trilinos matrix (in the numbering of node ids)
      * and solved by GMRES with an AMG preconditioner.
      */
+    template <int dim>
     class FictitiousNodeProblem
     {
     public:
@@ -174,13 +179,13 @@ namespace PeriDEAL
        * distance) with @p cracks, and run the mirror-node algorithm.
        */
       FictitiousNodeProblem(const MPI_Comm                  comm,
-                            const Domain<2>                &domain,
+                            const Domain<dim>              &domain,
                             const std::vector<Crack>       &cracks,
                             const FictitiousNodeParameters &parameters);
 
       /** Solve the steady problem with the boundary data @p bc. */
       void
-      solve(const BoundaryData &bc);
+      solve(const BoundaryData<dim> &bc);
 
       /**
        * Transient PD diffusion du/dt = L u + f (unit diffusivity, the steady
@@ -192,15 +197,15 @@ namespace PeriDEAL
        * Gershgorin bound of that operator (ParameterError).
        */
       void
-      advance(const TransientBoundaryData &bc,
-              const TransientSource       &source,
+      advance(const TransientBoundaryData<dim> &bc,
+              const TransientSource<dim>       &source,
               double                      &t,
               const double                 dt,
               const unsigned int           n_steps);
 
       /** The Gershgorin bound of forward Euler for the operator with data @p bc. */
       FnmTimeStepBound
-      gershgorin_time_step(const BoundaryData &bc) const;
+      gershgorin_time_step(const BoundaryData<dim> &bc) const;
 
       /**
        * The critical forward Euler step from the eigenvalues of the operator
@@ -209,7 +214,7 @@ namespace PeriDEAL
        * positive real part).
        */
       double
-      eigenvalue_time_step(const BoundaryData &bc) const;
+      eigenvalue_time_step(const BoundaryData<dim> &bc) const;
 
       /**
        * The body changes (corrosion / phase change: the nodes outside
@@ -223,11 +228,11 @@ namespace PeriDEAL
        * recomputed.
        */
       unsigned int
-      change_domain(const Domain<2> *new_body, const std::vector<Crack> &new_cracks = {});
+      change_domain(const Domain<dim> *new_body, const std::vector<Crack> &new_cracks = {});
 
       /** @name Nodes (replicated, sorted by lattice id) */
       /** @{ */
-      std::vector<Point<2>> position;
+      std::vector<Point<dim>> position;
       /** True for nodes of the body, false for collar nodes. */
       std::vector<bool> in_domain;
       /** The index function r of (14) (domain nodes; 0 on the collar). */
@@ -237,7 +242,7 @@ namespace PeriDEAL
       /** @} */
 
       /** The fictitious nodes with their mirror data. */
-      std::vector<FictitiousNode> fictitious;
+      std::vector<FictitiousNode<dim>> fictitious;
 
       /** Number of domain nodes (unknowns). */
       unsigned int
@@ -250,17 +255,17 @@ namespace PeriDEAL
       /** Wall time of the last solve (assembly + solver) [s]. */
       double last_solve_seconds = 0.;
 
-      /** Node index at lattice position (i, j), or invalid. */
+      /** Node index at lattice position @p index, or invalid. */
       unsigned int
-      node_at(const int i, const int j) const;
+      node_at(const std::array<int, dim> &index) const;
 
       /** The generalized normal (15)-(16) at an arbitrary node (used by tests). */
-      Tensor<1, 2>
+      Tensor<1, dim>
       generalized_normal(const unsigned int node, const bool across_crack) const;
 
       /** Value at @p p: the node value, or the mean of the 4 nearest domain nodes. */
       double
-      value_at(const Point<2> &p) const;
+      value_at(const Point<dim> &p) const;
 
       const FictitiousNodeParameters &
       parameters() const
@@ -269,27 +274,34 @@ namespace PeriDEAL
       }
 
     private:
-      /** Bond weight beta V / |xi|^2 of lattice offset (di, dj) (0: no bond). */
-      double
-      weight(const int di, const int dj) const;
+      /** A bond of the lattice: offset, weight beta V / |xi|^2, |offset|^2 in lattice units. */
+      struct Bond
+      {
+        std::array<int, dim> offset;
+        double               weight;
+        double               length2;
+      };
+      /** The node at lattice[k] + offset, or invalid. */
+      unsigned int
+      neighbor(const unsigned int k, const std::array<int, dim> &offset) const;
       /** True if the segment between nodes crosses a crack. */
       bool
       cut(const unsigned int i, const unsigned int j) const;
       /** The closest boundary point of an outside point (signed distance projection). */
-      Point<2>
-      project(const Point<2> &p) const;
+      Point<dim>
+      project(const Point<dim> &p) const;
       /** The boundary point on the segment from inside @p a to outside @p b. */
-      Point<2>
-      intersect(const Point<2> &a, const Point<2> &b) const;
+      Point<dim>
+      intersect(const Point<dim> &a, const Point<dim> &b) const;
       /** Node j belongs to H^Omega of k (and, if side is valid, is connected to side). */
       bool
       in_omega_part(const unsigned int k, const unsigned int j, const bool across_crack,
                     const unsigned int side) const;
       /** (15)-(16) restricted to the nodes connected to @p side (invalid: all). */
-      Tensor<1, 2>
+      Tensor<1, dim>
       generalized_normal(const unsigned int k, const bool across_crack, const unsigned int side) const;
       /** Sect. 3.4 steps 2a-2c for fictitious node k (H^Omega restricted to @p side). */
-      FictitiousNode
+      FictitiousNode<dim>
       make_mirror(const unsigned int k, const bool across, const unsigned int side) const;
       /** (14) for the nodes flagged in @p which (all if empty). */
       void
@@ -311,13 +323,13 @@ namespace PeriDEAL
         struct DataTerm
         {
           unsigned int row;
-          Point<2>     point;
+          Point<dim>   point;
           double       coefficient;
         };
         std::vector<DataTerm> data;
       };
       Operator
-      assemble(const BoundaryData &bc) const;
+      assemble(const BoundaryData<dim> &bc) const;
       /** The forward Euler operator of advance(), reset by change_domain(). */
       struct TransientOperator
       {
@@ -332,14 +344,14 @@ namespace PeriDEAL
       gather_solution(const std::vector<double> &owned_values, const unsigned int begin);
 
       MPI_Comm                 comm;
-      const Domain<2>         *domain;
+      const Domain<dim>       *domain;
       std::vector<Crack>       cracks;
       FictitiousNodeParameters prm;
-      int                      n_lattice[2] = {0, 0};
-      Point<2>                 origin;
+      std::array<int, dim>     n_lattice;
+      Point<dim>               origin;
       /** Node index of each lattice point (invalid: none). */
       std::vector<unsigned int> node_of_lattice;
-      std::vector<std::array<int, 2>> lattice;
+      std::vector<std::array<int, dim>> lattice;
       /** Unknown number of each domain node. */
       std::vector<unsigned int> unknown;
       unsigned int              n_domain = 0;
@@ -348,7 +360,8 @@ namespace PeriDEAL
       /** Index into fictitious per node (collar role / crack role). */
       std::vector<unsigned int> fictitious_of_node, crack_fictitious_of_node;
       int                       reach = 0;
-      std::vector<double>       weights;
+      /** The bonds of a full family (weight > 0). */
+      std::vector<Bond> bonds;
     };
   } // namespace Boundary
 } // namespace PeriDEAL
