@@ -511,6 +511,25 @@ namespace PeriDEAL
           const auto b_minus = [&](const Point<dim> &p, const double coefficient) {
             op.data.push_back({unknown[i] - begin, p, -coefficient});
           };
+          // row += w u_G for a mirrored fictitious node f.
+          const auto add_mirror_value = [&](const FictitiousNode<dim> &f, const double w) {
+            const LocalCondition c = bc(f.boundary_point);
+            if (c.type == LocalCondition::dirichlet)
+              {
+                // (10): u_G = 2 u_b - u_m.
+                row[unknown[f.mirror]] -= w;
+                b_minus(f.boundary_point, 2. * w);
+              }
+            else
+              {
+                // (11)-(12), outward flux g + alpha u at the midpoint:
+                // u_G (1 - L alpha/2) = u_m (1 + L alpha/2) + L g.
+                const double L   = position[f.node].distance(position[f.mirror]);
+                const double den = 1. - 0.5 * L * c.alpha;
+                row[unknown[f.mirror]] += w * (1. + 0.5 * L * c.alpha) / den;
+                b_minus(f.boundary_point, w * L / den);
+              }
+          };
           const auto naive = [&](const unsigned int j, const double w) {
             const Point<dim>     p = project(position[j]);
             const LocalCondition c = bc(p);
@@ -588,35 +607,54 @@ namespace PeriDEAL
                     default:
                       {
                         const FictitiousNode<dim> &f = fictitious[fictitious_of_node[j]];
-                        if (f.mirror == numbers::invalid_unsigned_int)
+                        if (f.mirror != numbers::invalid_unsigned_int)
                           {
-                            // No mirror (sharp convex corners): naive fallback.
+                            row[unknown[i]] -= w;
+                            add_mirror_value(f, w);
+                            break;
+                          }
+                        // No mirror (sharp convex corners, Sect. 3.4): the
+                        // average of the surrounding fictitious constraints,
+                        // or the naive FNM.
+                        const auto sources = prm.corner_fallback == CornerFallback::average ?
+                                               corner_average_sources(j) :
+                                               std::vector<unsigned int>();
+                        if (sources.empty())
+                          {
                             naive(j, w);
                             break;
                           }
-                        const LocalCondition c = bc(f.boundary_point);
                         row[unknown[i]] -= w;
-                        if (c.type == LocalCondition::dirichlet)
-                          {
-                            // (10): u_G = 2 u_b - u_m.
-                            row[unknown[f.mirror]] -= w;
-                            b_minus(f.boundary_point, 2. * w);
-                          }
-                        else
-                          {
-                            // (11)-(12), outward flux g + alpha u at the midpoint:
-                            // u_G (1 - L alpha/2) = u_m (1 + L alpha/2) + L g.
-                            const double L   = position[j].distance(position[f.mirror]);
-                            const double den = 1. - 0.5 * L * c.alpha;
-                            row[unknown[f.mirror]] += w * (1. + 0.5 * L * c.alpha) / den;
-                            b_minus(f.boundary_point, w * L / den);
-                          }
+                        for (const unsigned int g : sources)
+                          add_mirror_value(fictitious[fictitious_of_node[g]], w / sources.size());
                       }
                   }
               }
         }
 
       return op;
+    }
+
+    template <int dim>
+    std::vector<unsigned int>
+    FictitiousNodeProblem<dim>::corner_average_sources(const unsigned int node) const
+    {
+      // The mirrored collar nodes in the smallest lattice ring around the
+      // node that holds any (at most one horizon out).
+      std::vector<unsigned int> sources;
+      for (int radius = 1; radius <= reach && sources.empty(); ++radius)
+        for (const auto &o : cube<dim>(radius))
+          {
+            int ring = 0;
+            for (const int v : o)
+              ring = std::max(ring, std::abs(v));
+            const unsigned int g = neighbor(node, o);
+            if (ring == radius && g != numbers::invalid_unsigned_int && !in_domain[g] &&
+                fictitious_of_node[g] != numbers::invalid_unsigned_int &&
+                fictitious[fictitious_of_node[g]].mirror != numbers::invalid_unsigned_int)
+              sources.push_back(g);
+          }
+      return sources;
     }
 
     template <int dim>

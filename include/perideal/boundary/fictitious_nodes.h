@@ -117,6 +117,18 @@ namespace PeriDEAL
       bool diagonally_dominant = true;
     };
 
+    /**
+     * What the mirror FNM does for a fictitious node without mirror node
+     * (sharp convex corners, Sect. 3.4 of paper 004): the naive FNM, or the
+     * average of the constraints of the surrounding mirrored fictitious
+     * nodes (the closest lattice ring holding any).
+     */
+    enum class CornerFallback
+    {
+      naive,
+      average
+    };
+
     /** Parameters of a FictitiousNodeProblem. */
     struct FictitiousNodeParameters
     {
@@ -127,6 +139,8 @@ namespace PeriDEAL
       FictitiousNodeMethod method = FictitiousNodeMethod::mirror;
       /** lambda of the stabilized Taylor FNM (7) (>= 1; paper: 1.5). */
       double taylor_lambda = 1.5;
+      /** Fallback of the mirror FNM for fictitious nodes without mirror. */
+      CornerFallback corner_fallback = CornerFallback::naive;
       /** Relative GMRES residual tolerance (in (0, 1)). */
       double tolerance = 1e-11;
     };
@@ -266,6 +280,14 @@ namespace PeriDEAL
       /** Value at @p p: the node value, or the mean of the 4 nearest domain nodes. */
       double
       value_at(const Point<dim> &p) const;
+
+      /**
+       * The collar nodes whose mirror constraints are averaged for the
+       * unmirrored fictitious node @p node (CornerFallback::average; empty:
+       * naive).
+       */
+      std::vector<unsigned int>
+      corner_average_sources(const unsigned int node) const;
 
       const FictitiousNodeParameters &
       parameters() const
