@@ -3,7 +3,7 @@ perideal_add_test_program(abc_tests ${CMAKE_CURRENT_LIST_DIR}/abc_tests.cc)
 foreach(_t dispersion frames_and_guards)
   perideal_add_test(NAME abc.${_t} COMMAND $<TARGET_FILE:abc_tests> ${_t} LABELS unit)
 endforeach()
-foreach(_t fem_1d fem_2d pd_1d pd_2d pd_fourier pd_layer_study)
+foreach(_t fem_1d fem_2d pd_1d pd_2d pd_fourier pd_layer_study corrosion_2d)
   perideal_add_test(NAME abc.${_t} COMMAND $<TARGET_FILE:abc_tests> ${_t} LABELS convergence)
 endforeach()
 perideal_add_test(NAME abc.pd_rank_invariance.np2 NPROCS 2
