@@ -51,7 +51,7 @@ namespace Step6
     double       shape_size = 1., solid_concentration = 2.;
     double       R = 2., R_ref = 10., dx = 0.02, delta = 0.04, dt = 1e-5, t_end = 0.085;
     double       record_interval = 0.001;
-    bool         neumann_run = true;
+    bool         neumann_run = true, cube = false;
     std::string  output_directory = "step-6-output";
     DiffusionModelParameters model;
     Abc::EbfParameters       abc;
@@ -71,6 +71,9 @@ namespace Step6
                         "Radius of the truncated domain, absorbing layer included.");
       prm.declare_entry("Reference radius", "10", Patterns::Double(0.),
                         "Extended Neumann domain (0: no reference run).");
+      prm.declare_entry("Truncation", "ball", Patterns::Selection("ball|cube"),
+                        "Shape of the near field (and of the reference): the ball of the "
+                        "near-field radius or the cube (-R, R)^dim.");
       prm.declare_entry("Neumann run", "true", Patterns::Bool(),
                         "Also run the near field with Neumann truncation.");
       prm.declare_entry("Grid spacing", "0.02", Patterns::Double(0.));
@@ -101,6 +104,7 @@ namespace Step6
       R                   = prm.get_double("Near-field radius");
       R_ref               = prm.get_double("Reference radius");
       neumann_run         = prm.get_bool("Neumann run");
+      cube                = prm.get("Truncation") == "cube";
       dx                  = prm.get_double("Grid spacing");
       delta               = prm.get_double("Horizon");
       dt                  = prm.get_double("Time step");
@@ -202,11 +206,15 @@ namespace Step6
     LatticeParameters lp;
     lp.dx    = p.dx;
     lp.delta = p.delta;
+    Point<dim> corner;
+    for (unsigned int d = 0; d < dim; ++d)
+      corner[d] = radius;
     BallDomain<dim>                ball(Point<dim>(), radius);
+    BoxDomain<dim>                 box(-corner, corner);
     InitialConcentration<dim>      c0(p);
     Abc::PdUnboundedDiffusion<dim> run(MPI_COMM_WORLD);
     Timer                          timer;
-    run.setup(ball, lp, p.model, p.dt, boundary, p.abc, c0);
+    run.setup(p.cube ? static_cast<const Domain<dim> &>(box) : ball, lp, p.model, p.dt, boundary, p.abc, c0);
     Series s;
     s.name      = name;
     s.nodes     = run.discretization().n_global();
@@ -223,7 +231,10 @@ namespace Step6
     // Pi and the mass on Omega_N of the truncated run (radius R - delta_L).
     const double layer = p.abc.layer_thickness > 0 ? p.abc.layer_thickness : p.delta;
     const typename Abc::PdUnboundedDiffusion<dim>::Region omega_n = [&](const Point<dim> &x) {
-      return p.R - x.norm() >= layer - 1e-8 * p.dx;
+      double r = 0.; // max norm (cube) or Euclidean norm (ball)
+      for (unsigned int d = 0; d < dim; ++d)
+        r = std::max(r, std::abs(x[d]));
+      return p.R - (p.cube ? r : x.norm()) >= layer - 1e-8 * p.dx;
     };
     const auto record = [&]() {
       s.energy.push_back(run.energy(omega_n));
