@@ -52,6 +52,7 @@ namespace Step6
     double       R = 2., R_ref = 10., dx = 0.02, delta = 0.04, dt = 1e-5, t_end = 0.085;
     double       record_interval = 0.001;
     bool         neumann_run = true, cube = false;
+    double       required_gain = 10.;
     std::string  output_directory = "step-6-output";
     DiffusionModelParameters model;
     Abc::EbfParameters       abc;
@@ -76,6 +77,8 @@ namespace Step6
                         "near-field radius or the cube (-R, R)^dim.");
       prm.declare_entry("Neumann run", "true", Patterns::Bool(),
                         "Also run the near field with Neumann truncation.");
+      prm.declare_entry("Required gain over Neumann", "10", Patterns::Double(0.),
+                        "Check: Delta Pi/Pi0 at t_f of the Neumann run over that of the ABC run.");
       prm.declare_entry("Grid spacing", "0.02", Patterns::Double(0.));
       prm.declare_entry("Horizon", "0.04", Patterns::Double(0.));
       prm.declare_entry("Time step", "1e-5", Patterns::Double(0.));
@@ -105,6 +108,7 @@ namespace Step6
       R_ref               = prm.get_double("Reference radius");
       neumann_run         = prm.get_bool("Neumann run");
       cube                = prm.get("Truncation") == "cube";
+      required_gain       = prm.get_double("Required gain over Neumann");
       dx                  = prm.get_double("Grid spacing");
       delta               = prm.get_double("Horizon");
       dt                  = prm.get_double("Time step");
@@ -173,8 +177,14 @@ namespace Step6
         letters = hzg_letters(p.shape_size);
     }
     double
-    value(const Point<dim> &x, const unsigned int = 0) const override
+    value(const Point<dim> &x_in, const unsigned int = 0) const override
     {
+      // Letter edges run through lattice nodes, and the lattices of the
+      // near field and the reference place a node differently by round-off:
+      // snap to 1e-9 so that both runs start from the same solid.
+      Point<dim> x;
+      for (unsigned int d = 0; d < dim; ++d)
+        x[d] = 1e-9 * std::round(x_in[d] * 1e9);
       bool solid = false;
       if (p.shape == "sphere")
         solid = x.norm() <= p.shape_size;
@@ -349,8 +359,9 @@ namespace Step6
         check(std::isfinite(runs[0].energy.back()), "ABC run stays finite");
         check(runs[0].monotone, "ABC: near-field energy non-increasing at every record (Fig. 4.16)");
         if (ref && p.neumann_run)
-          check(difference(runs[1], n_records - 1) > 10. * difference(runs[0], n_records - 1),
-                "ABC >= 10x closer to the reference than Neumann at t_f (Fig. 4.15)");
+          check(difference(runs[1], n_records - 1) > p.required_gain * difference(runs[0], n_records - 1),
+                "ABC >= " + std::to_string(p.required_gain) +
+                  "x closer to the reference than Neumann at t_f (Fig. 4.15)");
       }
     return Utilities::MPI::max(failures, MPI_COMM_WORLD) == 0 ? 0 : 1;
   }
