@@ -29,18 +29,28 @@ namespace PeriDEAL
       check_parameter(time_step > 0 && time_step <= op->critical_time_step(), "Time step", time_step,
                       "0 < dt <= " + std::to_string(op->critical_time_step()) +
                         " (forward Euler bound of the PD operator)");
-      dt = time_step;
-      t  = 0.;
+      dt               = time_step;
+      t                = 0.;
+      model_parameters = model;
       disc.initialize_vector(C);
       disc.initialize_vector(rate);
+      disc.initialize_vector(phase);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
-        C.local_element(i) = initial.value(disc.position[i]);
+        {
+          C.local_element(i) = initial.value(disc.position[i]);
+          // Initial phase as in DiffusionSolver: solid where C0 >= C_sat.
+          if (op->is_corrosion())
+            phase.local_element(i) = C.local_element(i) >= model.saturation ? 1. : 0.;
+        }
+      phase.update_ghost_values();
 
+      const double delta = lattice.delta;
+      const double layer = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
+      absorbing.assign(disc.n_owned(), false);
+      abc = EbfDiffusionAbc<dim>();
       if (boundary == TruncationBoundary::neumann)
         return;
-      const double delta    = lattice.delta;
-      const double layer    = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
-      const double h        = 1e-3 * lattice.dx;
+      const double h = 1e-3 * lattice.dx;
       // The ghost layer holds every node within delta + dx/2 of an owned node.
       check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
                       prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
@@ -50,8 +60,9 @@ namespace PeriDEAL
       // Absorbing nodes: the owned nodes closer than delta_L to the
       // truncation boundary (delta_L / dx node layers); the outward normal
       // is the gradient of the signed distance.
-      std::vector<unsigned int>   absorbing;
+      std::vector<unsigned int>   absorbing_nodes;
       std::vector<Tensor<1, dim>> normals;
+      bool                        solid_absorbing = false;
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         {
           const Point<dim> &x = disc.position[i];
@@ -65,15 +76,24 @@ namespace PeriDEAL
                   xm[d] -= h;
                   n[d] = domain.signed_distance(xp) - domain.signed_distance(xm);
                 }
-              absorbing.push_back(i);
+              absorbing_nodes.push_back(i);
+              absorbing[i] = true;
               normals.push_back(n / n.norm());
+              solid_absorbing = solid_absorbing || phase.local_element(i) > 0.5;
             }
         }
+      // The far field is the electrolyte: the modes solve liquid diffusion.
+      check_parameter(!Utilities::MPI::logical_or(solid_absorbing, disc.get_mpi_communicator()),
+                      "Initial condition", "solid (C0 >= C_sat) in the absorbing layer",
+                      "a solid body at least delta_L inside the truncation boundary");
       std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
+      ScalarKernel far_kernel = op->kernel();
+      if (op->is_corrosion())
+        far_kernel.constant = model.kappa_liquid;
       const DiffusionDispersion dispersion =
-        prm.dispersion == "local" ? DiffusionDispersion::local(op->kernel().local_coefficient()) :
-                                    DiffusionDispersion::nonlocal(op->kernel());
-      abc.reinit(disc.position, ids, absorbing, normals, dispersion, dt, prm,
+        prm.dispersion == "local" ? DiffusionDispersion::local(far_kernel.local_coefficient()) :
+                                    DiffusionDispersion::nonlocal(far_kernel);
+      abc.reinit(disc.position, ids, absorbing_nodes, normals, dispersion, dt, prm,
                  disc.get_mpi_communicator());
     }
 
@@ -87,7 +107,7 @@ namespace PeriDEAL
       const auto abc_start = clock::now();
       abc.compute(C.begin(), boundary_values);
       const auto abc_end = clock::now();
-      op->apply(C, rate);
+      op->apply(C, rate, &phase);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         C.local_element(i) += dt * rate.local_element(i);
       const auto set_start = clock::now();
@@ -95,6 +115,12 @@ namespace PeriDEAL
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         C.local_element(absorbing[a]) = boundary_values[a];
       const auto end = clock::now();
+      // Phase rule (2.79) on C^{n+1}: changed bonds act from the next step.
+      if (op->is_corrosion())
+        {
+          update_corrosion_phase(model_parameters, C, phase, disc.n_owned());
+          phase.update_ghost_values();
+        }
       t += dt;
       abc_seconds += std::chrono::duration<double>(abc_end - abc_start + end - set_start).count();
       step_seconds += std::chrono::duration<double>(end - start).count();
@@ -111,7 +137,51 @@ namespace PeriDEAL
       return Utilities::MPI::sum(e, disc.get_mpi_communicator());
     }
 
+    template <int dim>
+    double
+    PdUnboundedDiffusion<dim>::energy(const Region &inside) const
+    {
+      double e = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (inside(disc.position[i]))
+          e += C.local_element(i) * C.local_element(i) * disc.volume[i];
+      return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    double
+    PdUnboundedDiffusion<dim>::mass(const Region &inside) const
+    {
+      double m = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (inside(disc.position[i]))
+          m += C.local_element(i) * disc.volume[i];
+      return Utilities::MPI::sum(m, disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    double
+    PdUnboundedDiffusion<dim>::solid_volume() const
+    {
+      double v = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        v += phase.local_element(i) * disc.volume[i];
+      return Utilities::MPI::sum(v, disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    double
+    PdUnboundedDiffusion<dim>::near_field_energy() const
+    {
+      double e = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (!absorbing[i])
+          e += C.local_element(i) * C.local_element(i) * disc.volume[i];
+      return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+    }
+
     template class PdUnboundedDiffusion<1>;
     template class PdUnboundedDiffusion<2>;
+    template class PdUnboundedDiffusion<3>;
   } // namespace Abc
 } // namespace PeriDEAL

@@ -126,6 +126,28 @@ namespace PeriDEAL
                     kappa_solid, "a non-negative number");
   }
 
+  bool
+  update_corrosion_phase(const DiffusionModelParameters &p,
+                         const Vector                   &C,
+                         Vector                         &phase,
+                         const unsigned int              n_owned)
+  {
+    bool changed = false;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      {
+        const bool solid = phase.local_element(i) > 0.5;
+        // one-way (2.79): solid -> liquid below C_sat; 003 (6): both ways
+        const bool to_liquid = solid && C.local_element(i) < p.saturation;
+        const bool to_solid  = p.reversible_phase && !solid && C.local_element(i) >= p.saturation;
+        if (to_liquid || to_solid)
+          {
+            phase.local_element(i) = to_solid ? 1. : 0.;
+            changed                = true;
+          }
+      }
+    return changed;
+  }
+
   template <int dim>
   DiffusionOperator<dim>::DiffusionOperator(const Discretization<dim>      &discretization,
                                             const DiffusionModelParameters &p)

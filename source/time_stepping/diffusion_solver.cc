@@ -405,20 +405,7 @@ namespace PeriDEAL
   void
   DiffusionSolver<dim>::update_phase()
   {
-    bool changed = false;
-    for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      {
-        const bool solid = phase.local_element(i) > 0.5;
-        // one-way (2.79): solid -> liquid below C_sat; 003 (6): both ways
-        const bool to_liquid = solid && C.local_element(i) < prm.model.saturation;
-        const bool to_solid  = prm.model.reversible_phase && !solid &&
-                              C.local_element(i) >= prm.model.saturation;
-        if (to_liquid || to_solid)
-          {
-            phase.local_element(i) = to_solid ? 1. : 0.;
-            changed                = true;
-          }
-      }
+    const bool changed = update_corrosion_phase(prm.model, C, phase, disc.n_owned());
     phase.update_ghost_values();
     if (Utilities::MPI::logical_or(changed, mpi_communicator))
       matrix_valid = false;

@@ -8,6 +8,7 @@
 #include <perideal/discretization/discretization.h>
 #include <perideal/models/diffusion.h>
 
+#include <functional>
 #include <memory>
 
 namespace PeriDEAL
@@ -31,6 +32,14 @@ namespace PeriDEAL
      * have a signed distance (box, ball). Works on any number of ranks:
      * clouds use the node partitioner's ghosts (d_inf <= delta is required,
      * which every ghost layer covers).
+     *
+     * With a corrosion model (Model/Type = corrosion, dissertation
+     * Sect. 4.1.5) the near field is the bi-material body: three bond
+     * micro-diffusivities chosen by the phases of the end points and the
+     * phase rule (2.79) after every step. The absorbing nodes must lie in
+     * the electrolyte, whose far field is linear diffusion with the liquid
+     * diffusivity: the ABC modes use D_liq (local) or the kernel with
+     * kappa_liq (nonlocal).
      */
     template <int dim>
     class PdUnboundedDiffusion
@@ -38,10 +47,15 @@ namespace PeriDEAL
     public:
       PdUnboundedDiffusion(const MPI_Comm comm);
 
+      /** Predicate on positions (energy regions). */
+      using Region = std::function<bool(const Point<dim> &)>;
+
       /**
        * Build the lattice, the operator and (for @p boundary absorbing) the
        * clouds; set C = @p initial. @p time_step must satisfy the operator's
-       * Gershgorin bound.
+       * Gershgorin bound. For corrosion the nodes with C >= C_sat start
+       * solid (as in DiffusionSolver); a solid absorbing node is a
+       * ParameterError.
        */
       void
       setup(const Domain<dim>              &domain,
@@ -60,6 +74,25 @@ namespace PeriDEAL
       double
       energy(const BoundingBox<dim> &region) const;
 
+      /** Pi = sum C_i^2 V_i (eq. 48 of 002) over the nodes with @p inside(x). */
+      double
+      energy(const Region &inside) const;
+
+      /** sum C_i V_i over the nodes with @p inside(x). */
+      double
+      mass(const Region &inside) const;
+
+      /** Volume of the solid nodes (0 for linear diffusion). */
+      double
+      solid_volume() const;
+
+      /**
+       * Pi over the near field Omega_N without the absorbing layer (all
+       * nodes for Neumann truncation).
+       */
+      double
+      near_field_energy() const;
+
       /** Current time. */
       double
       time() const
@@ -77,6 +110,12 @@ namespace PeriDEAL
       {
         return disc;
       }
+      /** The phase field (1 solid, 0 liquid); zero for linear diffusion. */
+      const Vector &
+      phase_field() const
+      {
+        return phase;
+      }
       /** The ABC (empty for Neumann truncation). */
       const EbfDiffusionAbc<dim> &
       absorbing_boundary() const
@@ -90,9 +129,12 @@ namespace PeriDEAL
       Discretization<dim>                   disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       EbfDiffusionAbc<dim>                  abc;
-      Vector                                C, rate;
+      Vector                                C, rate, phase;
       std::vector<double>                   boundary_values;
       double                                dt = 0., t = 0.;
+      DiffusionModelParameters              model_parameters;
+      /** Per owned node: in the absorbing layer. */
+      std::vector<bool> absorbing;
     };
   } // namespace Abc
 } // namespace PeriDEAL

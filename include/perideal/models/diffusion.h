@@ -102,6 +102,19 @@ namespace PeriDEAL
   };
 
   /**
+   * The corrosion phase rule on the first @p n_owned entries: one-way (2.79),
+   * solid (1) to liquid (0) once C < C_sat, or with
+   * DiffusionModelParameters::reversible_phase the rule (6) of 003 (solid
+   * whenever C >= C_sat). Returns true if a node changed on this rank; the
+   * caller updates the ghosts.
+   */
+  bool
+  update_corrosion_phase(const DiffusionModelParameters &parameters,
+                         const Vector                   &C,
+                         Vector                         &phase,
+                         const unsigned int              n_owned);
+
+  /**
    * The standard-scheme PD transport operator (3.4)
    * @f[ (L C)_i = \sum_{j \in F_i} \kappa_{ij} \, \omega(|\xi|) |\xi|^{-p}
    *      \beta(\xi) V_j \, (C_j - C_i), @f]
