@@ -12,3 +12,9 @@ foreach(_t time_step breaking)
 endforeach()
 perideal_add_test(NAME lps.breaking.np2 NPROCS 2
   COMMAND $<TARGET_FILE:lps_tests> breaking LABELS "unit;mpi")
+# LPS in explicit mechanics runs (helper lps).
+foreach(_t explicit_patch explicit_momentum)
+  perideal_add_test(NAME lps.${_t} COMMAND $<TARGET_FILE:lps_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME lps.explicit_momentum.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:lps_tests> explicit_momentum LABELS "unit;mpi")
