@@ -11,6 +11,7 @@
 
 #include "../check.h"
 
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -781,6 +782,178 @@ namespace
     explicit_momentum_case<3>();
   }
 
+  // A 2D LPS plate (plane strain) in tension, pulled by grips moving at
+  // +-V, with a pre-crack from the left edge to the middle; s0 from G0.
+  // Runs until the crack (damage >= 0.35 ahead of the pre-crack tip) is
+  // 2 delta long or max_steps.
+  struct LPSCrack
+  {
+    std::map<types::particle_index, std::array<double, 3>> nodes; // u_x, u_y, damage
+    std::uint64_t         n_broken = 0;
+    unsigned int          steps    = 0;
+    MechanicsMeasurements start, end;
+    double                far_damage = 0., s0 = 0.;
+  };
+
+  const double lps_crack_y = 29.5, lps_crack_tip = 19.5;
+
+  MechanicsRunParameters<2>
+  lps_crack_parameters(const MPI_Comm comm)
+  {
+    auto p = lps_run<2>(Point<2>(0, 0), Point<2>(59, 59), 1., 3.015);
+    p.lattice.cell_centered = false;
+    p.density               = 1.;
+    // s0 = sqrt(pi G0 / (3 K_2 delta)) = 0.01007 for K_2 = K + G/3 = 2.4.
+    p.lps.fracture_energy      = 7e-4;
+    p.precracks                = {{Point<2>(-1, lps_crack_y), Point<2>(lps_crack_tip, lps_crack_y)}};
+    p.prescribed_velocities    = {{"y - 2.5", "0; -5e-4"}, {"56.5 - y", "0; 5e-4"}};
+    p.measure_crack            = true;
+    p.crack_origin             = Point<2>(lps_crack_tip, lps_crack_y);
+    p.crack_region             = std::to_string(lps_crack_tip) + " - x";
+    p.end_time                 = 1e6;
+    p.time_series_interval     = 1000000;
+    p.output_directory = std::string("lps_crack_np") + std::to_string(Utilities::MPI::n_mpi_processes(comm));
+    return p;
+  }
+
+  LPSCrack
+  lps_crack_run(const MPI_Comm comm, const unsigned int max_steps)
+  {
+    const auto         p = lps_crack_parameters(comm);
+    MechanicsSolver<2> solver(comm, p);
+    solver.setup();
+    LPSCrack r;
+    r.s0    = solver.model().critical_stretch();
+    r.start = solver.measure();
+    const double delta = p.lattice.delta;
+    while (solver.integrator().step() < max_steps)
+      {
+        solver.run(20);
+        if (solver.measure().crack_length >= 2. * delta)
+          break;
+      }
+    r.steps    = solver.integrator().step();
+    r.end      = solver.measure();
+    r.n_broken = solver.model().n_broken_bonds();
+    const auto &disc = solver.discretization();
+    PeriDEAL::Vector phi;
+    disc.initialize_vector(phi);
+    solver.model().damage(phi);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        r.nodes[disc.id[i]] = {solver.integrator().displacement[0].local_element(i),
+                               solver.integrator().displacement[1].local_element(i),
+                               phi.local_element(i)};
+        if (std::abs(disc.position[i][1] - lps_crack_y) > 2. * delta)
+          r.far_damage = std::max(r.far_damage, phi.local_element(i));
+      }
+    r.far_damage = Utilities::MPI::max(r.far_damage, comm);
+    return r;
+  }
+
+  const unsigned int lps_crack_steps = 3000;
+
+  // The crack grows from the tip, straight ahead (mode I), and damage
+  // stays 0 farther than 2 delta from the crack line.
+  void
+  explicit_crack()
+  {
+    const LPSCrack r = lps_crack_run(MPI_COMM_WORLD, lps_crack_steps);
+    check(std::abs(r.s0 - std::sqrt(M_PI * 7e-4 / (3. * (K + G / 3.) * 3.015))) < 1e-15,
+          "s0 from G0 = " + sci(r.s0));
+    check(r.start.crack_length < 3.015, "initially no crack node ahead of the tip beyond delta (" +
+                                          sci(r.start.crack_length) + ")");
+    check(r.steps < lps_crack_steps && r.end.crack_length >= 2. * 3.015,
+          "the crack ran 2 delta ahead of the tip after " + std::to_string(r.steps) +
+            " steps (length " + sci(r.end.crack_length) + ")");
+    const double a = r.end.crack_angle > 90. ? 180. - r.end.crack_angle : r.end.crack_angle;
+    check(a < 5., "straight ahead: crack angle " + sci(r.end.crack_angle) + " deg (" +
+                    std::to_string(r.end.n_crack_nodes) + " nodes)");
+    check(r.far_damage == 0., "damage 0 farther than 2 delta from the crack line");
+  }
+
+  // Checkpoint and resume of an LPS run while the crack grows: stop 40
+  // steps after the checkpoint at step 200, resume (back to step 200) and
+  // run to step 300: bitwise the uninterrupted run (displacements and the
+  // broken bonds restored from the checkpoint by node ids).
+  void
+  explicit_resume()
+  {
+    auto p = lps_crack_parameters(MPI_COMM_WORLD);
+    p.output_directory += "_resume";
+    std::filesystem::remove_all(p.output_directory);
+    const auto state = [](const MechanicsSolver<2> &s) {
+      std::map<types::particle_index, std::array<double, 2>> u;
+      for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
+        u[s.discretization().id[i]] = {s.integrator().displacement[0].local_element(i),
+                                       s.integrator().displacement[1].local_element(i)};
+      return u;
+    };
+    MechanicsSolver<2> straight(MPI_COMM_WORLD, p);
+    straight.run(300);
+    const auto reference = state(straight);
+    p.checkpoint_interval = 200;
+    std::uint64_t broken_at_checkpoint = 0;
+    {
+      MechanicsSolver<2> first(MPI_COMM_WORLD, p);
+      first.run(200);
+      broken_at_checkpoint = first.model().n_broken_bonds();
+      first.run(40);
+    }
+    p.resume = true;
+    MechanicsSolver<2> resumed(MPI_COMM_WORLD, p);
+    resumed.run(100);
+    check(resumed.integrator().step() == 300, "resumed at step 200, now at " +
+                                                std::to_string(resumed.integrator().step()));
+    const auto u    = state(resumed);
+    double     diff = 0.;
+    for (const auto &e : reference)
+      for (unsigned int d = 0; d < 2; ++d)
+        diff = std::max(diff, std::abs(u.at(e.first)[d] - e.second[d]));
+    diff = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    check(straight.model().n_broken_bonds() > broken_at_checkpoint,
+          "bonds break after the checkpoint (" + std::to_string(broken_at_checkpoint) + " -> " +
+            std::to_string(straight.model().n_broken_bonds()) + ")");
+    check(resumed.model().n_broken_bonds() == straight.model().n_broken_bonds(),
+          "broken bonds " + std::to_string(resumed.model().n_broken_bonds()) + " = uninterrupted " +
+            std::to_string(straight.model().n_broken_bonds()));
+    check(diff == 0., "max |u - u_uninterrupted| = " + sci(diff));
+  }
+
+  // The crack run on all ranks and on rank 0 alone.
+  void
+  explicit_crack_ranks()
+  {
+    const LPSCrack world = lps_crack_run(MPI_COMM_WORLD, lps_crack_steps);
+    const auto     all   = Utilities::MPI::gather(MPI_COMM_WORLD, world.nodes, 0);
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) != 0)
+      return;
+    const LPSCrack self = lps_crack_run(MPI_COMM_SELF, lps_crack_steps);
+    std::map<types::particle_index, std::array<double, 3>> merged;
+    for (const auto &m : all)
+      merged.insert(m.begin(), m.end());
+    double       diff = 0., umax = 0.;
+    unsigned int matched = 0;
+    for (const auto &e : self.nodes)
+      {
+        const auto it = merged.find(e.first);
+        if (it == merged.end())
+          continue;
+        ++matched;
+        for (unsigned int d = 0; d < 3; ++d)
+          {
+            diff = std::max(diff, std::abs(it->second[d] - e.second[d]));
+            umax = std::max(umax, std::abs(e.second[d]));
+          }
+      }
+    const std::string tag = std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) + " ranks vs 1: ";
+    check(matched == self.nodes.size() && matched == merged.size(), tag + std::to_string(matched) + " nodes matched");
+    check(diff <= 1e-12 * std::max(1., umax), tag + "max |u, damage diff| = " + sci(diff));
+    check(world.steps == self.steps && world.n_broken == self.n_broken,
+          tag + "steps " + std::to_string(world.steps) + " vs " + std::to_string(self.steps) +
+            ", broken bonds " + std::to_string(world.n_broken) + " vs " + std::to_string(self.n_broken));
+  }
+
   void
   rank_invariance()
   {
@@ -801,5 +974,8 @@ main(int argc, char **argv)
               {"time_step", time_step},
               {"breaking", breaking},
               {"explicit_patch", explicit_patch},
-              {"explicit_momentum", explicit_momentum}});
+              {"explicit_momentum", explicit_momentum},
+              {"explicit_crack", explicit_crack},
+              {"explicit_crack_ranks", explicit_crack_ranks},
+              {"explicit_resume", explicit_resume}});
 }

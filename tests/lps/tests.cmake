@@ -18,3 +18,7 @@ foreach(_t explicit_patch explicit_momentum)
 endforeach()
 perideal_add_test(NAME lps.explicit_momentum.np2 NPROCS 2
   COMMAND $<TARGET_FILE:lps_tests> explicit_momentum LABELS "unit;mpi")
+perideal_add_test(NAME lps.explicit_crack COMMAND $<TARGET_FILE:lps_tests> explicit_crack LABELS unit)
+perideal_add_test(NAME lps.explicit_crack.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:lps_tests> explicit_crack_ranks LABELS mpi)
+perideal_add_test(NAME lps.explicit_resume COMMAND $<TARGET_FILE:lps_tests> explicit_resume LABELS unit)
