@@ -22,3 +22,7 @@ perideal_add_test(NAME lps.explicit_crack COMMAND $<TARGET_FILE:lps_tests> expli
 perideal_add_test(NAME lps.explicit_crack.np2 NPROCS 2
   COMMAND $<TARGET_FILE:lps_tests> explicit_crack_ranks LABELS mpi)
 perideal_add_test(NAME lps.explicit_resume COMMAND $<TARGET_FILE:lps_tests> explicit_resume LABELS unit)
+perideal_add_test(NAME lps.fracture_energy COMMAND $<TARGET_FILE:lps_tests> fracture_energy LABELS unit)
+foreach(_t wave reaction_inertia)
+  perideal_add_test(NAME lps.${_t} COMMAND $<TARGET_FILE:lps_tests> ${_t} LABELS unit)
+endforeach()
