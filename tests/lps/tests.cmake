@@ -26,3 +26,15 @@ perideal_add_test(NAME lps.fracture_energy COMMAND $<TARGET_FILE:lps_tests> frac
 foreach(_t wave reaction_inertia)
   perideal_add_test(NAME lps.${_t} COMMAND $<TARGET_FILE:lps_tests> ${_t} LABELS unit)
 endforeach()
+# Problem = mechanics, Mechanics/Model = LPS through the driver on 2 ranks:
+# straight run vs stop-and-resume (identical node tables), bonds breaking.
+set(_wd ${CMAKE_BINARY_DIR}/tests/run/lps_plate)
+file(MAKE_DIRECTORY ${_wd})
+perideal_add_test(NAME lps.driver.resume.np2
+  COMMAND ${CMAKE_CURRENT_LIST_DIR}/run_resume.sh $<TARGET_FILE:perideal-driver>
+          ${CMAKE_CURRENT_LIST_DIR}/lps_plate.prm ${DEAL_II_MPIEXEC} -n 2 --oversubscribe
+  LABELS "unit;mpi" WORKING_DIRECTORY ${_wd})
+set_tests_properties(lps.driver.resume.np2 PROPERTIES PROCESSORS 2)
+perideal_add_test(NAME lps.driver.bad_input
+  COMMAND ${CMAKE_CURRENT_LIST_DIR}/../driver/expect_failure.sh "Mechanics/Model"
+          $<TARGET_FILE:perideal-driver> ${CMAKE_CURRENT_LIST_DIR}/bad_lps_1d.prm LABELS unit)

@@ -48,7 +48,8 @@ namespace PeriDEAL
   /**
    * Critical stretch s0 of the LPS bond-breaking criterion for the fracture
    * energy @p G0 (dim 2: plane strain, 3). Bond energies as in Silling and
-   * Askari (2005) / Madenci and Oterkus (2014, Sect. 4.4): the work to break
+   * Askari (2005) and Madenci and Oterkus (2014, Peridynamic Theory and
+   * Its Applications): the work to break
    * the bonds crossing a unit crack area, each bond loaded to s0, with the
    * pair energy w(xi) = c_eq omega(|xi|) s^2 |xi| / 2 of the bond-based
    * material that has the same energy density d^2 K_d s^2 / 2 as the LPS
