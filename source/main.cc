@@ -51,8 +51,8 @@ namespace
                       "Spatial dimension of the run (1, 2 or 3).");
     prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics|static mechanics"),
                       "diffusion: PD diffusion and bi-material corrosion (Model/Type); "
-                      "mechanics: dynamic bond-based PD with brittle fracture "
-                      "(Model/Bond-based, Mechanics); static mechanics: static equilibrium "
+                      "mechanics: dynamic bond-based PD or LPS with brittle fracture "
+                      "(Mechanics/Model, Model/Bond-based or Model/LPS, Mechanics); static mechanics: static equilibrium "
                       "of linearized bond-based PD or LPS (Static mechanics).");
     // The entries do not depend on the dimension; declare them once.
     DiffusionRunParameters<2>::declare_parameters(prm);

@@ -2,6 +2,7 @@
 
 #include <perideal/models/bond_damage.h>
 #include <perideal/base/exceptions.h>
+#include <perideal/models/bond_based.h>
 #include <perideal/models/lps.h>
 
 #include <cmath>
@@ -18,7 +19,11 @@ namespace PeriDEAL
     prm.declare_entry("Shear modulus", "1", Patterns::Double(), "G (> 0).");
     prm.declare_entry("Critical stretch", "0", Patterns::Double(),
                       "s0 (>= 0) of the bond-breaking criterion on the linearized "
-                      "stretch; 0: bonds never break.");
+                      "stretch; 0: s0 from the fracture energy, or bonds never break.");
+    prm.declare_entry("Fracture energy", "0", Patterns::Double(),
+                      "G0 (>= 0): s0 = sqrt(5 G0 / (9 K delta)) (3D) or sqrt(pi G0 / (3 (K + "
+                      "G/3) delta)) (2D plane strain) for omega_0 (see lps_critical_stretch); "
+                      "used if Critical stretch = 0; 0: bonds never break.");
   }
 
   void
@@ -32,6 +37,26 @@ namespace PeriDEAL
     critical_stretch = prm.get_double("Critical stretch");
     check_parameter(critical_stretch >= 0., "Model/Critical stretch", critical_stretch,
                     "a non-negative number (0: no bond breaking)");
+    fracture_energy = prm.get_double("Fracture energy");
+    check_parameter(fracture_energy >= 0., "Model/Fracture energy", fracture_energy,
+                    "a non-negative number (0: no bond breaking)");
+  }
+
+  double
+  lps_critical_stretch(const unsigned int      dim,
+                       const InfluenceFunction omega,
+                       const double            delta,
+                       const double            K_d,
+                       const double            G0)
+  {
+    check_parameter(dim == 2 || dim == 3, "Dimension", dim, "2 or 3 for LPS");
+    // c_eq = 4 W / (|S| int omega r^d) with W = d^2 K_d / 2 per s^2: the
+    // bond-based micromodulus for E = 1 (plane strain) rescaled from its
+    // CCM expansion energy to the LPS one.
+    const double W     = 0.5 * dim * dim * K_d;
+    const double c_eq  = bond_based_micromodulus(dim, omega, delta, 1., false) * W /
+                        isotropic_expansion_energy(dim, 1., false);
+    return bond_based_critical_stretch(dim, omega, delta, c_eq, G0);
   }
 
   template <int dim>
@@ -40,12 +65,19 @@ namespace PeriDEAL
     : disc(discretization)
     , K_d(dim == 3 ? p.bulk_modulus : p.bulk_modulus + p.shear_modulus / 3.)
     , G(p.shear_modulus)
-    , s0(p.critical_stretch > 0. ? p.critical_stretch : std::numeric_limits<double>::infinity())
+    , s0(p.critical_stretch > 0. ? p.critical_stretch :
+         p.fracture_energy > 0.  ? lps_critical_stretch(dim, p.omega, discretization.parameters().delta,
+                                                        dim == 3 ? p.bulk_modulus :
+                                                                   p.bulk_modulus + p.shear_modulus / 3.,
+                                                        p.fracture_energy) :
+                                   std::numeric_limits<double>::infinity())
   {
     check_parameter(p.bulk_modulus > 0., "Model/Bulk modulus", p.bulk_modulus, "a positive number");
     check_parameter(p.shear_modulus > 0., "Model/Shear modulus", p.shear_modulus,
                     "a positive number");
     check_parameter(p.critical_stretch >= 0., "Model/Critical stretch", p.critical_stretch,
+                    "a non-negative number (0: no bond breaking)");
+    check_parameter(p.fracture_energy >= 0., "Model/Fracture energy", p.fracture_energy,
                     "a non-negative number (0: no bond breaking)");
     const auto  &nb    = disc.neighborhood;
     const double delta = disc.parameters().delta;
@@ -232,6 +264,73 @@ namespace PeriDEAL
           if (xe / r2 > s0)
             broken_flag[b] = 1;
         }
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::set_broken_flags(const std::vector<std::uint8_t> &flags)
+  {
+    AssertThrow(flags.size() == broken_flag.size(),
+                ExcMessage("One broken flag per bond of the owned rows is needed."));
+    broken_flag = flags;
+  }
+
+  template <int dim>
+  double
+  LinearizedLPSOperator<dim>::critical_time_step(const double rho) const
+  {
+    const auto &nb = disc.neighborhood;
+    const auto &x  = disc.position;
+    // Q_k = d / m_k^2 sum_l w_kl 2 |xi_kl|_1, owned, then ghosts.
+    Vector Q;
+    disc.initialize_vector(Q);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double *coef = bond_coefficient.data() + nb.table_start[i];
+        double        s    = 0.;
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          {
+            double l1 = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              l1 += std::abs(x[nb.col[b]][d] - x[i][d]);
+            s += coef[b - nb.row_start[i]] * 2. * l1;
+          }
+        const double mi    = m.local_element(i);
+        Q.local_element(i) = mi > 0. ? dim * s / (mi * mi) : 0.;
+      }
+    Q.update_ghost_values();
+    const double a_vol = std::abs(dim * K_d - (dim + 2.) * G);
+    const double a_dev = dim * (dim + 2.) * G;
+    double       bound = 0.;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double *coef   = bond_coefficient.data() + nb.table_start[i];
+        const double  inv_mi = m.local_element(i) > 0. ? 1. / m.local_element(i) : 0.;
+        for (unsigned int a = 0; a < dim; ++a)
+          {
+            double dev = 0., sum_xi = 0., vol_j = 0.;
+            for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+              {
+                const std::int32_t j = nb.col[b];
+                const double       w = coef[b - nb.row_start[i]];
+                double             xi[dim], r = 0., l1 = 0.;
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    xi[d] = x[j][d] - x[i][d];
+                    r += xi[d] * xi[d];
+                    l1 += std::abs(xi[d]);
+                  }
+                r                   = std::sqrt(r);
+                const double inv_mj = m.local_element(j) > 0. ? 1. / m.local_element(j) : 0.;
+                dev += 2. * w * a_dev * (inv_mi + inv_mj) * std::abs(xi[a]) / r * l1 / r;
+                sum_xi += w * xi[a];
+                vol_j += w * std::abs(xi[a]) * Q.local_element(j);
+              }
+            bound = std::max(bound, dev + a_vol * (std::abs(sum_xi) * Q.local_element(i) + vol_j));
+          }
+      }
+    bound = Utilities::MPI::max(bound, disc.get_mpi_communicator());
+    return bound > 0. ? 2. * std::sqrt(rho / bound) : std::numeric_limits<double>::infinity();
   }
 
   template <int dim>

@@ -59,6 +59,19 @@ namespace PeriDEAL
       return mask;
     }
 
+    // True if an expression uses the variable t (a token t, not part of a name).
+    bool
+    depends_on_time(const std::string &text)
+    {
+      for (std::size_t k = text.find('t'); k != std::string::npos; k = text.find('t', k + 1))
+        {
+          const auto name_char = [](const char c) { return std::isalnum((unsigned char)c) || c == '_'; };
+          if ((k == 0 || !name_char(text[k - 1])) && (k + 1 == text.size() || !name_char(text[k + 1])))
+            return true;
+        }
+      return false;
+    }
+
     // The first dim of the ';'-separated expressions (extra ones are ignored,
     // so that one parameter file serves every dimension).
     template <int dim>
@@ -123,19 +136,32 @@ namespace PeriDEAL
     prm.enter_subsection("Bond-based");
     BondBasedModelParameters::declare_parameters(prm);
     prm.leave_subsection();
+    // Also declared by the static runs (same entries: declaring twice is harmless).
+    prm.enter_subsection("LPS");
+    LPSModelParameters::declare_parameters(prm);
+    prm.leave_subsection();
     prm.leave_subsection();
 
     prm.enter_subsection("Mechanics");
+    prm.declare_entry("Model", "bond-based", Patterns::Selection("bond-based|LPS"),
+                      "bond-based: PMB/GPBM or linearized bond-based PD (entries in "
+                      "Model/Bond-based); LPS: linearized state-based LPS (2.18)-(2.19) with "
+                      "bond breaking on the linearized stretch (entries in Model/LPS; 2D: "
+                      "plane strain; 2D/3D only).");
     prm.declare_entry("Density", "1", Patterns::Double(), "Mass density rho (> 0).");
+    prm.declare_entry("Initial displacement", "0; 0; 0", Patterns::Anything(),
+                      "Initial displacement, 'dim' expressions in x, y, z separated by ';'.");
     prm.declare_entry("Initial velocity", "0; 0; 0", Patterns::Anything(),
                       "Initial velocity, 'dim' expressions in x, y, z separated by ';' "
                       "(extra components are ignored).");
     prm.declare_entry("Body force", "0; 0; 0", Patterns::Anything(),
-                      "Body force density b of (2.20), 'dim' expressions separated by ';'.");
+                      "Body force density b of (2.20), 'dim' expressions in x, y, z (and t: "
+                      "then re-evaluated every step) separated by ';'.");
     prm.declare_entry("Prescribed velocities", "", Patterns::Anything(),
-                      "Node sets moving with a prescribed constant velocity: items "
-                      "'LEVEL SET : VX; VY[; VZ]' separated by '|'; the set is "
-                      "{LEVEL SET <= 0}; later items override earlier ones.");
+                      "Node sets moving with a prescribed velocity v(x, t): items "
+                      "'LEVEL SET : VX; VY[; VZ]' (expressions in x, y, z, t) separated by "
+                      "'|'; the set is {LEVEL SET <= 0}; later items override earlier ones. "
+                      "Held nodes drift with v(t + dt/2) over a step.");
     prm.declare_entry("Prescribed displacements", "", Patterns::Anything(),
                       "Node sets with a prescribed displacement u(x, t): items "
                       "'LEVEL SET : UX; UY[; UZ]' (expressions in x, y, z, t) separated by "
@@ -144,7 +170,8 @@ namespace PeriDEAL
     prm.declare_entry("Tractions", "", Patterns::Anything(),
                       "Surface tractions T (force per area) applied as the body force "
                       "T / h on the nodes of a layer of thickness h (Sect. 2.2): items "
-                      "'LEVEL SET : TX; TY[; TZ] : h' separated by '|' (expressions in x, y, z).");
+                      "'LEVEL SET : TX; TY[; TZ] : h' separated by '|' (expressions in x, y, z, "
+                      "t; with t they are re-evaluated every step).");
     prm.declare_entry("Pre-cracks", "", Patterns::Anything(),
                       "2D: segments 'x0, y0, x1, y1'; 3D: planar polygons 'x0, y0, z0, x1, "
                       "y1, z1, x2, y2, z2[, ...]'; separated by ';'. Bonds crossing them are "
@@ -184,12 +211,19 @@ namespace PeriDEAL
     p.enter_subsection("Bond-based");
     model.parse_parameters(p);
     p.leave_subsection();
+    p.enter_subsection("LPS");
+    lps.parse_parameters(p);
+    p.leave_subsection();
     p.leave_subsection();
 
     p.enter_subsection("Mechanics");
+    model_type = p.get("Model");
+    check_parameter(model_type == "bond-based" || dim >= 2, "Mechanics/Model", model_type,
+                    "bond-based in 1D (LPS is 2D/3D)");
     density = p.get_double("Density");
     check_parameter(density > 0., "Mechanics/Density", density, "a positive number");
-    initial_velocity = first_dim<dim>(p.get("Initial velocity"));
+    initial_displacement = first_dim<dim>(p.get("Initial displacement"));
+    initial_velocity     = first_dim<dim>(p.get("Initial velocity"));
     body_force       = first_dim<dim>(p.get("Body force"));
     prescribed_velocities =
       parse_regions<dim>(p.get("Prescribed velocities"), "Mechanics/Prescribed velocities", false);
@@ -250,7 +284,7 @@ namespace PeriDEAL
     end_time  = p.get_double("End time");
     p.leave_subsection();
     check_parameter(time_step >= 0., "Time stepping/Time step", time_step,
-                    "a positive number, or 0 for 0.9 x the critical step (3.8)");
+                    "a positive number, or 0 for 0.9 x the critical step");
     check_parameter(end_time > 0., "Time stepping/End time", end_time, "a positive number");
 
     p.enter_subsection("Output");
@@ -287,7 +321,23 @@ namespace PeriDEAL
   {
     disc.setup(*prm.domain, prm.lattice);
     n_global_bonds = disc.n_global_bonds();
-    op             = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
+    if (prm.model_type == "LPS")
+      {
+        if constexpr (dim >= 2)
+          {
+            lps = std::make_unique<LinearizedLPSOperator<dim>>(disc, prm.lps);
+            op  = make_mechanics_model(*lps);
+          }
+        else
+          throw ParameterError("Mechanics/Model", prm.model_type, "bond-based in 1D");
+      }
+    else
+      {
+        check_parameter(prm.model_type == "bond-based", "Mechanics/Model", prm.model_type,
+                        "bond-based|LPS");
+        bond_based = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
+        op         = make_mechanics_model(*bond_based);
+      }
     for (const auto &crack : prm.precracks)
       op->add_precrack(crack);
 
@@ -299,34 +349,64 @@ namespace PeriDEAL
     total_steps = (unsigned int)std::llround(prm.end_time / dt);
 
     const auto v0 = vector_function<dim>(prm.initial_velocity, "Mechanics/Initial velocity");
-    const auto b  = vector_function<dim>(prm.body_force, "Mechanics/Body force");
+    const auto u0 = prm.initial_displacement.empty() ?
+                      nullptr :
+                      vector_function<dim>(prm.initial_displacement, "Mechanics/Initial displacement");
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       for (unsigned int d = 0; d < dim; ++d)
         {
-          verlet->velocity[d].local_element(i)   = v0->value(disc.position[i], d);
-          verlet->body_force[d].local_element(i) = b->value(disc.position[i], d);
+          verlet->displacement[d].local_element(i) = u0 ? u0->value(disc.position[i], d) : 0.;
+          verlet->velocity[d].local_element(i)     = v0->value(disc.position[i], d);
         }
-    // Tractions: T / h on the nodes of the layer, so that sum b V = T x area.
+    // Body force and tractions (T / h on the nodes of the layer, so that
+    // sum b V = T x area); re-evaluated every step if an expression has t.
+    struct Load
+    {
+      std::shared_ptr<FunctionParser<dim>> f;
+      std::vector<bool>                    mask; // empty: all nodes
+      double                               scale;
+    };
+    auto loads = std::make_shared<std::vector<Load>>();
+    bool time_dependent = depends_on_time(prm.body_force);
+    loads->push_back({vector_function<dim>(prm.body_force, "Mechanics/Body force"), {}, 1.});
     for (const auto &r : prm.tractions)
       {
-        const auto mask = region_mask(disc, r.level_set);
-        const auto T    = vector_function<dim>(r.value, "Mechanics/Tractions");
-        for (unsigned int i = 0; i < disc.n_owned(); ++i)
-          if (mask[i])
-            for (unsigned int d = 0; d < dim; ++d)
-              verlet->body_force[d].local_element(i) += T->value(disc.position[i], d) / r.thickness;
+        loads->push_back({vector_function<dim>(r.value, "Mechanics/Tractions"),
+                          region_mask(disc, r.level_set), 1. / r.thickness});
+        time_dependent = time_dependent || depends_on_time(r.value);
       }
+    const Discretization<dim> *dp = &disc;
+    const auto evaluate_loads = [loads, dp](const double t, typename VelocityVerlet<dim>::VectorField &b) {
+      for (auto &c : b)
+        c = 0.;
+      for (const Load &l : *loads)
+        {
+          l.f->set_time(t);
+          for (unsigned int i = 0; i < dp->n_owned(); ++i)
+            if (l.mask.empty() || l.mask[i])
+              for (unsigned int d = 0; d < dim; ++d)
+                b[d].local_element(i) += l.scale * l.f->value(dp->position[i], d);
+        }
+    };
+    if (time_dependent)
+      verlet->set_body_force_function(evaluate_loads);
+    else
+      evaluate_loads(0., verlet->body_force);
 
     held_by.assign(disc.n_owned(), -1);
     int k = 0;
     for (const auto &r : prm.prescribed_velocities)
       {
         const auto mask = region_mask(disc, r.level_set);
-        const auto v    = vector_function<dim>(r.value, "Mechanics/Prescribed velocities");
-        Tensor<1, dim> value;
-        for (unsigned int d = 0; d < dim; ++d)
-          value[d] = v->value(Point<dim>(), d);
-        verlet->add_prescribed_velocity(mask, value);
+        std::shared_ptr<FunctionParser<dim>> v =
+          vector_function<dim>(r.value, "Mechanics/Prescribed velocities");
+        verlet->add_prescribed_velocity(mask, [v](const Point<dim> &x, const double t) {
+          v->set_time(t);
+          Tensor<1, dim> value;
+          for (unsigned int d = 0; d < dim; ++d)
+            value[d] = v->value(x, d);
+          return value;
+        });
         for (unsigned int i = 0; i < disc.n_owned(); ++i)
           if (mask[i])
             held_by[i] = k;
@@ -442,8 +522,13 @@ namespace PeriDEAL
     const auto    &F = verlet->internal_force();
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (held_by[i] == int(k))
-        for (unsigned int d = 0; d < dim; ++d)
-          R[d] -= (F[d].local_element(i) + verlet->body_force[d].local_element(i)) * disc.volume[i];
+        {
+          const Tensor<1, dim> a = verlet->held_acceleration(i);
+          for (unsigned int d = 0; d < dim; ++d)
+            R[d] += (prm.density * a[d] - F[d].local_element(i) -
+                     verlet->body_force[d].local_element(i)) *
+                    disc.volume[i];
+        }
     return Utilities::MPI::sum(R, mpi_communicator);
   }
 
@@ -483,8 +568,7 @@ namespace PeriDEAL
     std::ostringstream s;
     s.precision(16);
     s << "mechanics " << dim << " " << disc.n_global() << " " << prm.lattice.dx << " "
-      << prm.lattice.delta << " " << verlet->time_step() << " " << op->micromodulus() << " "
-      << op->critical_stretch();
+      << prm.lattice.delta << " " << verlet->time_step() << " " << op->description();
     return s.str();
   }
 
@@ -661,9 +745,9 @@ namespace PeriDEAL
             pcout << "Resumed from checkpoint at step " << verlet->step()
                   << ", t = " << verlet->time() << std::endl;
           }
-        pcout << "Bond-based PD in " << dim << "D: " << disc.n_global() << " nodes, "
-              << disc.n_global_bonds() << " bonds, c = " << op->micromodulus()
-              << ", s0 = " << op->critical_stretch() << ", dt = " << verlet->time_step()
+        pcout << "PD mechanics in " << dim << "D: " << disc.n_global() << " nodes, "
+              << disc.n_global_bonds() << " bonds, " << op->description()
+              << ", dt = " << verlet->time_step()
               << " (critical " << verlet->critical_time_step() << "), " << total_steps
               << " steps" << std::endl;
         if (!resumed)

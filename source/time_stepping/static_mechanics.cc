@@ -144,6 +144,9 @@ namespace PeriDEAL
     if (model == "LPS")
       check_parameter(lps.critical_stretch == 0., "Model/LPS/Critical stretch",
                       lps.critical_stretch, "0 for Problem = static mechanics (linear solve)");
+    if (model == "LPS")
+      check_parameter(lps.fracture_energy == 0., "Model/LPS/Fracture energy", lps.fracture_energy,
+                      "0 for Problem = static mechanics (linear solve)");
     else
       check_parameter(bond_based.critical_stretch == 0. && bond_based.fracture_energy == 0.,
                       "Model/Bond-based/Critical stretch, Fracture energy",

@@ -1,22 +1,162 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
+#include <sstream>
+#include <type_traits>
+
 namespace PeriDEAL
 {
+  namespace
+  {
+    // The MechanicsModel of an operator held by reference. The bond-based
+    // and LPS operators share these member names.
+    template <int dim, class Operator>
+    class Adapter : public MechanicsModel<dim>
+    {
+    public:
+      using VectorField = typename MechanicsModel<dim>::VectorField;
+      explicit Adapter(Operator &op)
+        : op(op)
+      {}
+      const Discretization<dim> &
+      discretization() const override
+      {
+        return op.discretization();
+      }
+      void
+      initialize(VectorField &f) const override
+      {
+        op.initialize(f);
+      }
+      void
+      compute_forces(const VectorField &u, VectorField &f) override
+      {
+        op.compute_forces(u, f);
+      }
+      void
+      strain_energy_density(const VectorField &u, Vector &W) const override
+      {
+        op.strain_energy_density(u, W);
+      }
+      double
+      total_strain_energy(const VectorField &u) const override
+      {
+        return op.total_strain_energy(u);
+      }
+      void
+      damage(Vector &phi) const override
+      {
+        op.damage(phi);
+      }
+      const std::vector<std::uint8_t> &
+      broken() const override
+      {
+        return op.broken();
+      }
+      void
+      set_broken_flags(const std::vector<std::uint8_t> &flags) override
+      {
+        op.set_broken_flags(flags);
+      }
+      std::uint64_t
+      n_broken_bonds() const override
+      {
+        return op.n_broken_bonds();
+      }
+      void
+      add_precrack(const std::vector<Point<dim>> &polygon) override
+      {
+        if constexpr (std::is_same_v<Operator, BondBasedOperator<dim>>)
+          op.add_precrack(polygon);
+        else
+          {
+            // The bond-based operator's crossing test on the same lattice,
+            // then its flags merged into the LPS ones.
+            BondBasedModelParameters bp;
+            BondBasedOperator<dim>   cut(op.discretization(), bp);
+            cut.add_precrack(polygon);
+            std::vector<std::uint8_t> flags = op.broken();
+            for (std::size_t b = 0; b < flags.size(); ++b)
+              flags[b] |= cut.broken()[b];
+            op.set_broken_flags(flags);
+          }
+      }
+      double
+      critical_time_step(const double rho) const override
+      {
+        return op.critical_time_step(rho);
+      }
+      double
+      critical_stretch() const override
+      {
+        return op.critical_stretch();
+      }
+      std::string
+      description() const override
+      {
+        std::ostringstream s;
+        s.precision(16);
+        if constexpr (std::is_same_v<Operator, BondBasedOperator<dim>>)
+          s << "bond-based c = " << op.micromodulus();
+        else
+          s << "LPS K_d = " << op.dimensional_bulk_modulus() << " G = " << op.shear_modulus();
+        s << " s0 = " << op.critical_stretch();
+        return s.str();
+      }
+
+    private:
+      Operator &op;
+    };
+  } // namespace
+
   template <int dim>
-  VelocityVerlet<dim>::VelocityVerlet(BondBasedOperator<dim> &model,
+  std::unique_ptr<MechanicsModel<dim>>
+  make_mechanics_model(BondBasedOperator<dim> &op)
+  {
+    return std::make_unique<Adapter<dim, BondBasedOperator<dim>>>(op);
+  }
+
+  template <int dim>
+  std::unique_ptr<MechanicsModel<dim>>
+  make_mechanics_model(LinearizedLPSOperator<dim> &op)
+  {
+    return std::make_unique<Adapter<dim, LinearizedLPSOperator<dim>>>(op);
+  }
+
+  template <int dim>
+  VelocityVerlet<dim>::VelocityVerlet(BondBasedOperator<dim> &op,
                                       const double            density,
                                       const double            time_step)
+    : owned_model(make_mechanics_model(op))
+    , model(*owned_model)
+    , disc(op.discretization())
+    , rho(density)
+    , dt(time_step)
+  {
+    setup();
+  }
+
+  template <int dim>
+  VelocityVerlet<dim>::VelocityVerlet(MechanicsModel<dim> &model,
+                                      const double         density,
+                                      const double         time_step)
     : model(model)
     , disc(model.discretization())
     , rho(density)
     , dt(time_step)
   {
+    setup();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::setup()
+  {
     check_parameter(rho > 0., "Density", rho, "a positive number");
     const double dt_crit = model.critical_time_step(rho);
     check_parameter(dt > 0. && dt <= dt_crit, "Time step", dt,
                     "0 < dt <= " + std::to_string(dt_crit) +
-                      " (critical time step (3.8) of the linearized model)");
+                      " (critical time step of the linearized model)");
     for (VectorField *f : {&displacement, &velocity, &acceleration, &body_force, &force})
       model.initialize(*f);
     prescribed_set.assign(disc.n_owned(), -1);
@@ -27,6 +167,44 @@ namespace PeriDEAL
   void
   VelocityVerlet<dim>::add_prescribed_velocity(const std::vector<bool> &mask,
                                                const Tensor<1, dim>    &v)
+  {
+    add_prescribed_velocity(mask, [v](const Point<dim> &, const double) { return v; });
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::set_body_force_function(
+    const std::function<void(const double, VectorField &)> &f)
+  {
+    body_force_function = f;
+    if (f)
+      f(t, body_force);
+  }
+
+  template <int dim>
+  Tensor<1, dim>
+  VelocityVerlet<dim>::held_acceleration(const unsigned int i) const
+  {
+    Tensor<1, dim> a;
+    const Point<dim> &x = disc.position[i];
+    if (displacement_set[i] >= 0)
+      {
+        const auto &u = prescribed_displacements[displacement_set[i]];
+        a = (u(x, t + dt) - 2. * u(x, t) + u(x, t - dt)) / (dt * dt);
+      }
+    else if (prescribed_set[i] >= 0)
+      {
+        const auto &v = prescribed_values[prescribed_set[i]];
+        a = (v(x, t + 0.5 * dt) - v(x, t - 0.5 * dt)) / dt;
+      }
+    return a;
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::add_prescribed_velocity(
+    const std::vector<bool>                                                &mask,
+    const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &v)
   {
     AssertThrow(mask.size() >= disc.n_owned(), ExcMessage("The mask must cover the owned nodes."));
     prescribed_values.push_back(v);
@@ -78,12 +256,15 @@ namespace PeriDEAL
 
   template <int dim>
   void
-  VelocityVerlet<dim>::apply_prescribed_velocities()
+  VelocityVerlet<dim>::apply_prescribed_velocities(const double time)
   {
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (prescribed_set[i] >= 0)
-        for (unsigned int d = 0; d < dim; ++d)
-          velocity[d].local_element(i) = prescribed_values[prescribed_set[i]][d];
+        {
+          const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time);
+          for (unsigned int d = 0; d < dim; ++d)
+            velocity[d].local_element(i) = v[d];
+        }
   }
 
   template <int dim>
@@ -106,7 +287,7 @@ namespace PeriDEAL
   void
   VelocityVerlet<dim>::initialize()
   {
-    apply_prescribed_velocities();
+    apply_prescribed_velocities(t);
     apply_prescribed_displacements(t, false);
     update_accelerations();
   }
@@ -117,6 +298,8 @@ namespace PeriDEAL
   {
     n_steps = step;
     t       = time;
+    if (body_force_function)
+      body_force_function(t, body_force);
     update_accelerations();
   }
 
@@ -126,8 +309,11 @@ namespace PeriDEAL
   {
     const unsigned int n = disc.n_owned();
     // Held nodes: u^{n+1} from the prescribed function, v = du/dt by the
-    // difference quotient (set first: it needs u^n).
+    // difference quotient (set first: it needs u^n); velocity sets drift
+    // with the midpoint velocity.
     apply_prescribed_displacements(t + dt, true);
+    if (!prescribed_values.empty())
+      apply_prescribed_velocities(t + 0.5 * dt);
     for (unsigned int d = 0; d < dim; ++d)
       {
         double       *u = displacement[d].begin();
@@ -140,6 +326,10 @@ namespace PeriDEAL
           }
       }
     apply_prescribed_displacements(t + dt, false);
+    if (!prescribed_values.empty())
+      apply_prescribed_velocities(t + dt);
+    if (body_force_function)
+      body_force_function(t + dt, body_force);
     update_accelerations();
     for (unsigned int d = 0; d < dim; ++d)
       {
@@ -179,6 +369,11 @@ namespace PeriDEAL
     return Utilities::MPI::sum(p, disc.get_mpi_communicator());
   }
 
+  template std::unique_ptr<MechanicsModel<1>> make_mechanics_model(BondBasedOperator<1> &);
+  template std::unique_ptr<MechanicsModel<2>> make_mechanics_model(BondBasedOperator<2> &);
+  template std::unique_ptr<MechanicsModel<3>> make_mechanics_model(BondBasedOperator<3> &);
+  template std::unique_ptr<MechanicsModel<2>> make_mechanics_model(LinearizedLPSOperator<2> &);
+  template std::unique_ptr<MechanicsModel<3>> make_mechanics_model(LinearizedLPSOperator<3> &);
   template class VelocityVerlet<1>;
   template class VelocityVerlet<2>;
   template class VelocityVerlet<3>;

@@ -31,6 +31,11 @@ namespace PeriDEAL
      * the linearized stretch xi . eta / |xi|^2; 0: bonds never break.
      */
     double critical_stretch = 0.;
+    /**
+     * Fracture energy G0 (>= 0); s0 is computed from it by
+     * lps_critical_stretch() unless critical_stretch > 0.
+     */
+    double fracture_energy = 0.;
 
     /** Declare the "Model" entries of the LPS model. */
     static void
@@ -39,6 +44,28 @@ namespace PeriDEAL
     void
     parse_parameters(ParameterHandler &prm);
   };
+
+  /**
+   * Critical stretch s0 of the LPS bond-breaking criterion for the fracture
+   * energy @p G0 (dim 2: plane strain, 3). Bond energies as in Silling and
+   * Askari (2005) and Madenci and Oterkus (2014, Peridynamic Theory and
+   * Its Applications): the work to break
+   * the bonds crossing a unit crack area, each bond loaded to s0, with the
+   * pair energy w(xi) = c_eq omega(|xi|) s^2 |xi| / 2 of the bond-based
+   * material that has the same energy density d^2 K_d s^2 / 2 as the LPS
+   * under the isotropic expansion u = s x (all bonds at stretch s):
+   *   c_eq = 2 d^2 K_d / (|S^{d-1}| int_0^delta omega r^d dr),
+   * then bond_based_critical_stretch(). For omega = 1:
+   *   3D: s0 = sqrt(5 G0 / (9 K delta))  (Madenci-Oterkus' LPS value
+   *        sqrt(G0 / ((3 G + (3/4)^4 (K - 5G/3)) delta)) at nu = 1/4),
+   *   2D: s0 = sqrt(pi G0 / (3 K_2 delta)), K_2 = K + G/3 = lambda + mu.
+   */
+  double
+  lps_critical_stretch(const unsigned int      dim,
+                       const InfluenceFunction omega,
+                       const double            delta,
+                       const double            dimensional_bulk_modulus,
+                       const double            fracture_energy);
 
   /**
    * The linearized state-based LPS model on the standard meshfree scheme.
@@ -171,6 +198,26 @@ namespace PeriDEAL
     {
       return broken_flag;
     }
+
+    /**
+     * Replace the broken flags of the owned rows (pre-cracks, checkpoints);
+     * both copies of a bond must agree.
+     */
+    void
+    set_broken_flags(const std::vector<std::uint8_t> &flags);
+
+    /**
+     * Critical time step 2 sqrt(rho / B) of velocity Verlet, with B >= the
+     * largest Gershgorin row sum sum_c |K_rc| of the linearized stiffness
+     * (an upper bound of lambda_max(K)), computed matrix-free from the
+     * triangle inequality: deviatoric part 2 sum_j w_ij a_dev (1/m_i + 1/m_j)
+     * |n_a| |n|_1, dilatational part |a_vol| (|sum_j w_ij xi_a| Q_i +
+     * sum_j w_ij |xi_a| Q_j) with Q_k = d/m_k^2 sum_l w_kl 2 |xi_kl|_1 the
+     * l1 norm of the gradient of theta_k / m_k (w = omega beta V). Intact
+     * bonds (the undamaged operator bounds every damaged one). Collective.
+     */
+    double
+    critical_time_step(const double rho) const;
 
     /** Global number of broken bond copies (each bond counts once per owned row). */
     std::uint64_t

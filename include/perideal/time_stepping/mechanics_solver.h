@@ -8,6 +8,7 @@
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/domain.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/models/lps.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
 #include <limits>
@@ -22,9 +23,10 @@ namespace PeriDEAL
   class TimeSeries;
 
   /**
-   * Everything an explicit bond-based PD run reads from its parameter file:
+   * Everything an explicit PD run reads from its parameter file:
    * geometry and discretization (shared with the diffusion runs), the
-   * bond-based model (Model/Bond-based), density, initial velocity, body
+   * model (Mechanics/Model: bond-based with Model/Bond-based, or LPS with
+   * Model/LPS), density, initial displacement and velocity, body
    * force, prescribed-velocity and prescribed-displacement regions,
    * tractions and pre-cracks (Mechanics), the measurements taken from the
    * damage and energy fields (Measurements), time stepping and output.
@@ -42,14 +44,21 @@ namespace PeriDEAL
 
     std::shared_ptr<Domain<dim>> domain;
     LatticeParameters            lattice;
+    /** "bond-based" or "LPS". */
+    std::string                  model_type = "bond-based";
     BondBasedModelParameters     model;
+    LPSModelParameters           lps;
     double                       density = 1.;
-    std::string                  initial_velocity, body_force;
-    /** Constant velocities (expressions in x, y, z). */
+    /** Initial displacement (empty: zero), velocity and body force expressions. */
+    std::string                  initial_displacement, initial_velocity, body_force;
+    /** Velocities v(x, t) (expressions in x, y, z, t). */
     std::vector<Region> prescribed_velocities;
     /** Displacements u(x, t) (expressions in x, y, z, t). */
     std::vector<Region> prescribed_displacements;
-    /** Tractions T (force per area), applied as the body force T / h in a layer of thickness h. */
+    /**
+     * Tractions T(x, t) (force per area), applied as the body force T / h in
+     * a layer of thickness h.
+     */
     std::vector<Region> tractions;
     /** 2D pre-crack segments (a, b). */
     std::vector<std::vector<Point<dim>>> precracks;
@@ -110,8 +119,9 @@ namespace PeriDEAL
   };
 
   /**
-   * Dynamic bond-based PD (PMB/GPBM with brittle fracture, or linearized)
-   * with velocity Verlet: the run behind `perideal` with
+   * Dynamic PD (bond-based PMB/GPBM with brittle fracture or linearized,
+   * or the linearized state-based LPS with bond breaking) with velocity
+   * Verlet: the run behind `perideal` with
    * `Problem = mechanics`. Writes displacement, velocity and damage to
    * VTU and to the CSV time series: kinetic/strain energy, broken bonds,
    * maximum damage, the reaction force of every prescribed region, the
@@ -147,7 +157,8 @@ namespace PeriDEAL
     {
       return disc;
     }
-    const BondBasedOperator<dim> &
+    /** The model (bond-based or LPS) behind a common interface. */
+    const MechanicsModel<dim> &
     model() const
     {
       return *op;
@@ -166,9 +177,10 @@ namespace PeriDEAL
     /**
      * Reaction force of prescribed region @p k (velocity regions first, then
      * displacement regions): the force the supports exert on the body,
-     * -sum_i (F_i + b_i) V_i over the nodes held by region k. The inertia
-     * of the held nodes is not included (zero for constant velocities).
-     * Collective.
+     * sum_i (rho a_i - F_i - b_i) V_i over the nodes held by region k, with
+     * a_i their acceleration from the prescribed motion
+     * (VelocityVerlet::held_acceleration; zero for constant velocities),
+     * so that the force balance of the held nodes closes. Collective.
      */
     Tensor<1, dim>
     reaction_force(const unsigned int k) const;
@@ -216,7 +228,11 @@ namespace PeriDEAL
     MPI_Comm                                mpi_communicator;
     MechanicsRunParameters<dim>             prm;
     Discretization<dim>                     disc;
-    std::unique_ptr<BondBasedOperator<dim>> op;
+    std::unique_ptr<BondBasedOperator<dim>> bond_based;
+    /** LPS (dim >= 2); std::nullptr_t-like void in 1D. */
+    std::unique_ptr<std::conditional_t<(dim >= 2), LinearizedLPSOperator<(dim >= 2 ? dim : 2)>, int>>
+                                           lps;
+    std::unique_ptr<MechanicsModel<dim>>   op;
     std::unique_ptr<VelocityVerlet<dim>>    verlet;
     unsigned int                            total_steps = 0;
     std::uint64_t                           n_global_bonds = 0;

@@ -4,32 +4,108 @@
 #include <deal.II/base/tensor.h>
 
 #include <perideal/models/bond_based.h>
+#include <perideal/models/lps.h>
 
 #include <functional>
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace PeriDEAL
 {
   /**
-   * Velocity-Verlet integration (3.5)-(3.6) of bond-based PD elasticity
-   * rho u'' = F(u) + b:
+   * What an explicit mechanics run needs from a PD solid model: forces,
+   * energies, damage, broken-bond flags (for pre-cracks and checkpoints) and
+   * the critical time step. Implemented by MechanicsModelAdapter for the
+   * bond-based (PMB/GPBM) and the LPS operators, which keep their own
+   * non-virtual force loops.
+   */
+  template <int dim>
+  class MechanicsModel
+  {
+  public:
+    using VectorField = std::array<Vector, dim>;
+
+    virtual ~MechanicsModel() = default;
+
+    /** The discretization. */
+    virtual const Discretization<dim> &
+    discretization() const = 0;
+    /** Zero-initialized dim node Vectors. */
+    virtual void
+    initialize(VectorField &field) const = 0;
+    /** Force density of the owned nodes (u with up-to-date ghosts); may break bonds. */
+    virtual void
+    compute_forces(const VectorField &u, VectorField &force) = 0;
+    /** Strain energy density W_i ((2.26) bond-based, (2.14) LPS) of the owned nodes. */
+    virtual void
+    strain_energy_density(const VectorField &u, Vector &W) const = 0;
+    /** sum_i W_i V_i over all ranks. */
+    virtual double
+    total_strain_energy(const VectorField &u) const = 0;
+    /** Damage (2.36) of the owned nodes. */
+    virtual void
+    damage(Vector &phi) const = 0;
+    /** Broken flag per CSR bond of the owned rows. */
+    virtual const std::vector<std::uint8_t> &
+    broken() const = 0;
+    /** Replace the broken flags (both copies of a bond must agree). */
+    virtual void
+    set_broken_flags(const std::vector<std::uint8_t> &flags) = 0;
+    /** Global number of broken bond copies. */
+    virtual std::uint64_t
+    n_broken_bonds() const = 0;
+    /** Break the bonds crossing a pre-crack polygon (2D: segment). */
+    virtual void
+    add_precrack(const std::vector<Point<dim>> &polygon) = 0;
+    /** Critical time step of the explicit scheme for density @p rho. */
+    virtual double
+    critical_time_step(const double rho) const = 0;
+    /** Critical stretch (infinity: no breaking). */
+    virtual double
+    critical_stretch() const = 0;
+    /** One line naming the model and its constants (log, checkpoint signature). */
+    virtual std::string
+    description() const = 0;
+  };
+
+  /** Adapter for BondBasedOperator. */
+  template <int dim>
+  std::unique_ptr<MechanicsModel<dim>>
+  make_mechanics_model(BondBasedOperator<dim> &op);
+  /** Adapter for LinearizedLPSOperator (2D/3D). */
+  template <int dim>
+  std::unique_ptr<MechanicsModel<dim>>
+  make_mechanics_model(LinearizedLPSOperator<dim> &op);
+
+  /**
+   * Velocity-Verlet integration (3.5)-(3.6) of PD elasticity
+   * rho u'' = F(u) + b (any MechanicsModel):
    *   v^{n+1/2} = v^n + dt/2 a^n,  u^{n+1} = u^n + dt v^{n+1/2},
    *   v^{n+1} = v^{n+1/2} + dt/2 a^{n+1},
    * with a = (F + b) / rho. Nodes of a prescribed-velocity set move with
-   * their given velocity (their acceleration is zero). The displacement
-   * ghosts are refreshed once per step, before the force evaluation.
+   * their given velocity v(x, t): u^{n+1} = u^n + dt v(t^{n+1/2}) (exact for
+   * v linear in t) and v^{n+1} = v(t^{n+1}); nodes of a prescribed-
+   * displacement set follow u(x, t). The kinematic acceleration of held
+   * nodes (central differences of the prescribed motion, see
+   * held_acceleration) does not enter the update but the reaction forces.
+   * A time-dependent body force (tractions) is re-evaluated at t^{n+1}
+   * before each force evaluation. The displacement ghosts are refreshed
+   * once per step, before the force evaluation.
    */
   template <int dim>
   class VelocityVerlet
   {
   public:
-    using VectorField = typename BondBasedOperator<dim>::VectorField;
+    using VectorField = typename MechanicsModel<dim>::VectorField;
 
     /**
      * @p density rho (> 0) and time step @p time_step, which must not exceed
-     * the critical step (3.8) of @p model (else ParameterError naming
+     * the critical step of @p model (else ParameterError naming
      * 'Time step'). u, v, a and the body force start at zero.
      */
+    VelocityVerlet(MechanicsModel<dim> &model, const double density, const double time_step);
+    /** The same for a bond-based operator (critical step (3.8)). */
     VelocityVerlet(BondBasedOperator<dim> &model, const double density, const double time_step);
 
     /** Displacement, velocity, acceleration (owned entries; u has ghosts). */
@@ -43,6 +119,42 @@ namespace PeriDEAL
      */
     void
     add_prescribed_velocity(const std::vector<bool> &mask, const Tensor<1, dim> &v);
+    /** The same with a velocity v(x, t). */
+    void
+    add_prescribed_velocity(
+      const std::vector<bool>                                                &mask,
+      const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &v);
+
+    /**
+     * Evaluate the body force b(t) with @p f(t, body_force) before every
+     * force evaluation (also now, at the current time).
+     */
+    void
+    set_body_force_function(const std::function<void(const double, VectorField &)> &f);
+
+    /**
+     * The acceleration of held node @p i < n_owned() at the current time t^n
+     * from its prescribed motion: (u(t+dt) - 2 u(t) + u(t-dt)) / dt^2 for a
+     * displacement set, (v(t+dt/2) - v(t-dt/2)) / dt for a velocity set (the
+     * second differences Verlet's own velocities satisfy); zero for free
+     * nodes. rho V times this is the inertia term of a reaction force.
+     */
+    Tensor<1, dim>
+    held_acceleration(const unsigned int i) const;
+
+    /** True if owned node @p i is held by a prescribed velocity or displacement. */
+    bool
+    is_held(const unsigned int i) const
+    {
+      return prescribed_set[i] >= 0 || displacement_set[i] >= 0;
+    }
+
+    /** Density rho. */
+    double
+    density() const
+    {
+      return rho;
+    }
 
     /**
      * Nodes i < n_owned() with @p mask[i] true follow the displacement
@@ -118,19 +230,26 @@ namespace PeriDEAL
     linear_momentum() const;
 
   private:
+    /** Checks and field initialization of the constructors. */
+    void
+    setup();
     void
     update_accelerations();
+    /** Held-velocity nodes get v(x, @p time). */
     void
-    apply_prescribed_velocities();
+    apply_prescribed_velocities(const double time);
 
-    BondBasedOperator<dim>    &model;
-    const Discretization<dim> &disc;
+    /** The adapter of the BondBasedOperator constructor (declared before model). */
+    std::unique_ptr<MechanicsModel<dim>> owned_model;
+    MechanicsModel<dim>                 &model;
+    const Discretization<dim>           &disc;
     double                     rho, dt, t = 0.;
     unsigned int               n_steps = 0;
     VectorField                force;
     /** Per owned node: index into prescribed_values, or -1. */
-    std::vector<int>            prescribed_set;
-    std::vector<Tensor<1, dim>> prescribed_values;
+    std::vector<int> prescribed_set;
+    std::vector<std::function<Tensor<1, dim>(const Point<dim> &, const double)>> prescribed_values;
+    std::function<void(const double, VectorField &)>                          body_force_function;
     /** Per owned node: index into prescribed_displacements, or -1. */
     std::vector<int> displacement_set;
     std::vector<std::function<Tensor<1, dim>(const Point<dim> &, const double)>>
