@@ -44,6 +44,8 @@ namespace PeriDEAL
                         "Guard on the moment matrices.");
       prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
                         "Guard on max_j |V_j| (Sect. 4.2.3).");
+      prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
+                        "Relative singular-value cutoff of M^+ (0: max(rows, cols) * machine epsilon).");
     }
 
     void
@@ -59,6 +61,7 @@ namespace PeriDEAL
       dispersion           = prm.get("Dispersion relation");
       max_condition_number = prm.get_double("Maximum condition number");
       max_update_norm      = prm.get_double("Maximum updating vector norm");
+      pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
     }
 
 
@@ -211,17 +214,26 @@ namespace PeriDEAL
       };
 
       Fit
-      fit(const CMatrix &M, const CRow &psi)
+      fit(const CMatrix &M, const CRow &psi, const double tolerance)
       {
-        Fit                                                             f;
-        const Eigen::CompleteOrthogonalDecomposition<CMatrix>           cod(M);
-        const CRow                                                      Vc = psi * cod.pseudoInverse();
+        // One SVD gives both the Moore-Penrose inverse and the condition
+        // number. Without a tolerance, Eigen's default rank threshold
+        // (max(rows, cols) * epsilon relative to sigma_max) is used.
+        Fit                           f;
+        const Eigen::BDCSVD<CMatrix>  svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
+        const auto                   &sv  = svd.singularValues();
+        const double                  tol = tolerance > 0. ? tolerance :
+                                                             std::max(M.rows(), M.cols()) *
+                                                               std::numeric_limits<double>::epsilon();
+        Eigen::Index rank = 0;
+        while (rank < sv.size() && sv[rank] > tol * sv[0])
+          ++rank;
+        const CRow Vc = ((psi * svd.matrixV().leftCols(rank)) *
+                         sv.head(rank).cwiseInverse().asDiagonal()) *
+                        svd.matrixU().leftCols(rank).adjoint();
         // Conjugate-closed mode sets and real data: V is real (the imaginary
         // part is round-off).
-        f.V                                       = Vc.real();
-        const Eigen::JacobiSVD<CMatrix>          svd(M);
-        const auto                              &sv   = svd.singularValues();
-        const unsigned int                       rank = cod.rank();
+        f.V    = Vc.real();
         f.cond = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
         f.vmax = Vc.cwiseAbs().maxCoeff();
         return f;
@@ -270,10 +282,13 @@ namespace PeriDEAL
 
       const double r = prm.cloud_radius;
       std::map<std::array<long, dim>, std::vector<unsigned int>> bins;
-      const auto bin_of = [r](const Point<dim> &p) {
+      // Bins slightly wider than d_inf, so that points at distance d_inf up
+      // to round-off are in the neighbouring bins.
+      const double w      = r * (1. + 1e-6);
+      const auto   bin_of = [w](const Point<dim> &p) {
         std::array<long, dim> b;
         for (unsigned int d = 0; d < dim; ++d)
-          b[d] = static_cast<long>(std::floor(p[d] / r));
+          b[d] = static_cast<long>(std::floor(p[d] / w));
         return b;
       };
       for (unsigned int i = 0; i < points.size(); ++i)
@@ -405,8 +420,8 @@ namespace PeriDEAL
                           MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
                         }
                   }
-              fg = fit(MG, psi_g);
-              fh = fit(MH, psi_h);
+              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance);
+              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance);
               ok = fg.cond <= prm.max_condition_number && fh.cond <= prm.max_condition_number &&
                    fg.vmax <= prm.max_update_norm && fh.vmax <= prm.max_update_norm;
             }
@@ -645,14 +660,14 @@ namespace PeriDEAL
 
     template <int dim>
     double
-    PdUnboundedWave<dim>::energy(const BoundingBox<dim> &region) const
+    PdUnboundedWave<dim>::energy(const std::function<bool(const Point<dim> &)> &inside) const
     {
       const auto   &nb = disc.neighborhood;
       const double *uu = u.begin();
       double        e  = 0.;
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         {
-          if (!region.point_inside(disc.position[i], 1e-10))
+          if (!inside(disc.position[i]))
             continue;
           const double *w   = bond_kernel_weight.data() + nb.table_start[i];
           double        row = 0.;
@@ -694,11 +709,11 @@ namespace PeriDEAL
 
     template <int dim>
     std::vector<std::pair<Point<dim>, double>>
-    PdUnboundedWave<dim>::gather(const BoundingBox<dim> &region) const
+    PdUnboundedWave<dim>::gather(const std::function<bool(const Point<dim> &)> &inside) const
     {
       std::vector<double> local;
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
-        if (region.point_inside(disc.position[i], 1e-10))
+        if (inside(disc.position[i]))
           {
             for (unsigned int dd = 0; dd < dim; ++dd)
               local.push_back(disc.position[i][dd]);
@@ -707,7 +722,7 @@ namespace PeriDEAL
       const auto all = Utilities::MPI::all_gather(disc.get_mpi_communicator(), local);
       std::vector<std::pair<Point<dim>, double>> out;
       for (const auto &chunk : all)
-        for (std::size_t q = 0; q + dim < chunk.size() + 0; q += dim + 1)
+        for (std::size_t q = 0; q + dim < chunk.size(); q += dim + 1)
           {
             Point<dim> p;
             for (unsigned int dd = 0; dd < dim; ++dd)

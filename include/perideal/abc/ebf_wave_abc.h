@@ -53,6 +53,11 @@ namespace PeriDEAL
       double max_condition_number = 1e12;
       /** Guard: largest admissible max_j |V_j| (Sect. 4.2.3: 2). */
       double max_update_norm = 2.;
+      /**
+       * Relative singular-value cutoff of the pseudo-inverse (0: Eigen's
+       * default rank threshold max(rows, cols) * epsilon).
+       */
+      double pseudo_inverse_tolerance = 0.;
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -141,8 +146,7 @@ namespace PeriDEAL
      * outward normal, the cloud restricted to the conic extrapolation region
      * (4.86) behind x_i, the complex outgoing modes (4.57) with the given
      * dispersion relation, the moment matrices M_G, M_H of two time levels
-     * (4.79), their Moore-Penrose inverses (Eigen complete orthogonal
-     * decomposition) and the updating vectors V_G = Psi(0, dt) M_G^+,
+     * (4.79), their Moore-Penrose inverses (Eigen SVD) and the updating vectors V_G = Psi(0, dt) M_G^+,
      * V_H = Psi'(0, dt) M_H^+ (4.82). If a cloud violates the guards
      * (condition number, max |V|) it is thinned by the nearest nodes to an
      * auxiliary grid of growing stride in the local frame
@@ -248,17 +252,17 @@ namespace PeriDEAL
       advance();
 
       /**
-       * Wave energy (4.99) of the nodes inside @p region: 1/2 sum v_i^2 V_i +
+       * Wave energy (4.99) of the nodes x_i with @p inside(x_i): 1/2 sum v_i^2 V_i +
        * 1/4 sum_i sum_j k (u_j - u_i)^2 beta V_j V_i (all ranks).
        */
       double
-      energy(const BoundingBox<dim> &region) const;
+      energy(const std::function<bool(const Point<dim> &)> &inside) const;
       /** u at the node nearest to @p p (all ranks agree). */
       double
       value_at(const Point<dim> &p) const;
-      /** (position, u) of the owned nodes inside @p region, gathered on all ranks. */
+      /** (position, u) of the nodes with @p inside(x), gathered on all ranks. */
       std::vector<std::pair<Point<dim>, double>>
-      gather(const BoundingBox<dim> &region) const;
+      gather(const std::function<bool(const Point<dim> &)> &inside) const;
 
       double
       time() const
