@@ -1,0 +1,310 @@
+#ifndef perideal_abc_ebf_wave_abc_h
+#define perideal_abc_ebf_wave_abc_h
+
+#include <deal.II/base/bounding_box.h>
+#include <deal.II/base/function.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/base/types.h>
+
+#include <perideal/base/kernel.h>
+#include <perideal/discretization/discretization.h>
+#include <perideal/discretization/domain.h>
+#include <perideal/models/diffusion.h>
+#include <perideal/models/scalar_wave.h>
+
+#include <complex>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  namespace Abc
+  {
+    /**
+     * Parameters of the EBF absorbing boundary for (viscous) scalar waves
+     * (dissertation Sect. 4.2.3): wave numbers k in [-Delta k, Delta k] and
+     * directions phi in [-Delta phi, Delta phi] about the outward normal
+     * (4.56), the conic extrapolation region (4.86) and the stability guards.
+     */
+    struct WaveAbcParameters
+    {
+      /** Subdivisions n_k of [-Delta k, Delta k] (n_k + 1 wave numbers, (4.98)). */
+      unsigned int n_wave_numbers = 10;
+      /** Delta k (4.56); must satisfy 0 < Delta k <= pi/dx (4.83). */
+      double wave_number_range = 1.;
+      /** Subdivisions n_phi of [-Delta phi, Delta phi] (2D; n_phi + 1 directions). */
+      unsigned int n_directions = 10;
+      /** Delta phi of the mode directions (4.56). */
+      double direction_range = M_PI / 4.;
+      /** Delta phi of the conic extrapolation region (4.86). */
+      double cone_angle = M_PI / 4.;
+      /** Cloud radius (0: the horizon delta for PD, 2 dx for FEM). */
+      double cloud_radius = 0.;
+      /** PD absorbing layer thickness delta_L (0: the horizon). */
+      double layer_thickness = 0.;
+      /** "local" (4.39), "nonlocal" (continuum PD, (4.47)/(4.51)/(4.90)) or "discrete" (4.85)/(4.95). */
+      std::string dispersion = "discrete";
+      /** Guard: largest admissible moment-matrix condition number. */
+      double max_condition_number = 1e12;
+      /** Guard: largest admissible max_j |V_j| (Sect. 4.2.3: 2). */
+      double max_update_norm = 2.;
+      /**
+       * Relative singular-value cutoff of the pseudo-inverse (0: Eigen's
+       * default rank threshold max(rows, cols) * epsilon).
+       */
+      double pseudo_inverse_tolerance = 0.;
+
+      static void
+      declare_parameters(ParameterHandler &prm);
+      /** The caller has entered "Absorbing boundary". */
+      void
+      parse_parameters(ParameterHandler &prm);
+    };
+
+    /**
+     * Dispersion relation of the harmonic far-field modes
+     * psi = exp(-d t) exp(i k n.x - i omega~(k n) t) (4.53), (4.57), written
+     * through the symbol Omega^2(k) of the (discrete or continuum) spatial
+     * operator, -L exp(i k.x) = Omega^2(k) exp(i k.x):
+     * omega~ = sign(k) sqrt(Omega^2 - d^2) (complex root when d^2 > Omega^2,
+     * then the slowly decaying overdamped branch), so that every mode with
+     * k < 0 is the complex conjugate of one with k > 0 and all travel outward.
+     */
+    template <int dim>
+    class WaveDispersion
+    {
+    public:
+      /** Omega^2 = chi^2 |k|^2 (4.39). */
+      static WaveDispersion
+      local(const double wave_speed, const double damping);
+      /**
+       * Continuum PD relation Omega^2(k) = int_H k(|xi|) (1 - cos(k.xi)) dxi
+       * (4.43), by radial Gauss quadrature of the closed-form angular
+       * integral (1D: 2 (1 - cos kr), 2D: 2 pi (1 - J_0(kr))); its Taylor
+       * series are (4.47), (4.51) and its 1D p = 0 form is (4.90).
+       */
+      static WaveDispersion
+      nonlocal(const ScalarKernel &kernel, const double damping);
+      /**
+       * Discrete relation (4.85)/(4.95) of the standard meshfree scheme:
+       * Omega^2(k) = sum_{j in F_0} k(|x_j|) (1 - cos(k.x_j)) beta(|x_j|) dx^dim
+       * over the lattice family of the origin with the near field's own
+       * volume factor (Discretization::volume_factor).
+       */
+      static WaveDispersion
+      discrete(const ScalarKernel &kernel, const double dx, const bool partial_volume,
+               const double damping);
+      /**
+       * The same with an explicit stencil (offsets xi_j and weights w_j,
+       * Omega^2 = sum_j w_j (1 - cos(k.xi_j))), e.g. a FEM row.
+       */
+      static WaveDispersion
+      stencil(const std::vector<Tensor<1, dim>> &offsets, const std::vector<double> &weights,
+              const double damping, const std::string &name);
+
+      /** Omega^2 for the wave vector @p k (global frame). */
+      double
+      symbol(const Tensor<1, dim> &k) const
+      {
+        return omega2(k);
+      }
+      /** omega~ for wave number @p k (signed) along unit direction @p n. */
+      std::complex<double>
+      frequency(const double k, const Tensor<1, dim> &n) const;
+      /** Damping d. */
+      double damping = 0.;
+      /** "local", "nonlocal", "discrete" or a stencil name. */
+      std::string name;
+
+    private:
+      std::function<double(const Tensor<1, dim> &)> omega2;
+    };
+
+    /** Summary of the clouds after setup (global over all ranks). */
+    struct WaveCloudStatistics
+    {
+      types::global_dof_index n_absorbing = 0;
+      unsigned int            min_cloud_size = 0, max_cloud_size = 0;
+      /** Number of modes n_b. */
+      unsigned int n_modes = 0;
+      /** Largest condition numbers of M_G and M_H (over retained singular values). */
+      double max_condition_number = 0.;
+      /** Largest max-norm of V_G and V_H. */
+      double max_update_norm = 0.;
+      /** Clouds that were thinned (auxiliary-grid stride > 1) and the largest stride. */
+      unsigned int n_thinned = 0, max_stride = 1;
+    };
+
+    /**
+     * The EBF absorbing boundary for viscous scalar waves (Sect. 4.2.3):
+     * for every owned absorbing node x_i a local frame with x along the
+     * outward normal, the cloud restricted to the conic extrapolation region
+     * (4.86) behind x_i, the complex outgoing modes (4.57) with the given
+     * dispersion relation, the moment matrices M_G, M_H of two time levels
+     * (4.79), their Moore-Penrose inverses (Eigen SVD) and the updating vectors V_G = Psi(0, dt) M_G^+,
+     * V_H = Psi'(0, dt) M_H^+ (4.82). If a cloud violates the guards
+     * (condition number, max |V|) it is thinned by the nearest nodes to an
+     * auxiliary grid of growing stride in the local frame
+     * (Fig. 4.23) until the guards hold; otherwise ParameterError.
+     */
+    template <int dim>
+    class EbfWaveAbc
+    {
+    public:
+      /**
+       * Precompute everything. @p points / @p ids: all points available on
+       * this rank (owned and ghost, local numbering) with global ids;
+       * @p absorbing: local indices of the owned absorbing points,
+       * @p outward_normals their normals; @p dx the near-field spacing (for
+       * (4.83) and the auxiliary grid).
+       */
+      void
+      reinit(const std::vector<Point<dim>>              &points,
+             const std::vector<types::global_dof_index> &ids,
+             const std::vector<unsigned int>            &absorbing,
+             const std::vector<Tensor<1, dim>>          &outward_normals,
+             const WaveDispersion<dim>                  &dispersion,
+             const double                                time_step,
+             const double                                dx,
+             const WaveAbcParameters                    &parameters,
+             const MPI_Comm                              comm);
+
+      /**
+       * u_new[a] = V_G . (u^n_j, u^{n-1}_j)_j, v_new[a] = V_H . (v^n_j, v^{n-1}_j)_j
+       * for every absorbing node a (arrays in local numbering, ghosts valid).
+       */
+      void
+      compute(const double        *u,
+              const double        *u_old,
+              const double        *v,
+              const double        *v_old,
+              std::vector<double> &u_new,
+              std::vector<double> &v_new) const;
+
+      const std::vector<unsigned int> &
+      absorbing_points() const
+      {
+        return absorbing;
+      }
+      /** Sorted unique local indices of all cloud points (what compute() reads). */
+      const std::vector<unsigned int> &
+      cloud_points() const
+      {
+        return all_cloud_points;
+      }
+      /** Cloud (local indices) of absorbing point a. */
+      std::vector<unsigned int>
+      cloud(const unsigned int a) const;
+      const WaveCloudStatistics &
+      statistics() const
+      {
+        return stats;
+      }
+      /** Rotation R with R n = e_1 (the local frame of Fig. 4.20). */
+      static Tensor<2, dim>
+      local_frame(const Tensor<1, dim> &outward_normal);
+
+    private:
+      std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
+      /** Per cloud entry: V_G and V_H for levels n and n-1. */
+      std::vector<double> vg_now, vg_old, vh_now, vh_old;
+      WaveCloudStatistics stats;
+    };
+
+    /** How the truncation boundary of a wave near field is treated. */
+    enum class WaveTruncation
+    {
+      /** The EBF absorbing boundary. */
+      absorbing,
+      /** Nothing: a free PD surface (reflecting). Used for the extended reference. */
+      free
+    };
+
+    /**
+     * PD scalar wave near field (2.40) on a truncated domain (box or ball):
+     * damped velocity Verlet (3.9)/(4.62) through the DiffusionOperator with
+     * kernel c_s omega / |xi|^p, and the EBF absorbing boundary on the nodes
+     * within delta_L of the truncation boundary (Sect. 4.2.3, 4.2.4, 4.2.6):
+     * their u and v are the extrapolated values (4.82). Works on any number
+     * of ranks (clouds within the ghost layer).
+     */
+    template <int dim>
+    class PdUnboundedWave
+    {
+    public:
+      explicit PdUnboundedWave(const MPI_Comm comm);
+
+      void
+      setup(const Domain<dim>          &domain,
+            const LatticeParameters    &lattice,
+            const ScalarWaveParameters &model,
+            const WaveTruncation        boundary,
+            const WaveAbcParameters    &abc,
+            const Function<dim>        &initial);
+
+      /** One velocity-Verlet step with the absorbing update. */
+      void
+      advance();
+
+      /**
+       * Wave energy (4.99) of the nodes x_i with @p inside(x_i): 1/2 sum v_i^2 V_i +
+       * 1/4 sum_i sum_j k (u_j - u_i)^2 beta V_j V_i (all ranks).
+       */
+      double
+      energy(const std::function<bool(const Point<dim> &)> &inside) const;
+      /** u at the node nearest to @p p (all ranks agree). */
+      double
+      value_at(const Point<dim> &p) const;
+      /** (position, u) of the nodes with @p inside(x), gathered on all ranks. */
+      std::vector<std::pair<Point<dim>, double>>
+      gather(const std::function<bool(const Point<dim> &)> &inside) const;
+
+      double
+      time() const
+      {
+        return t;
+      }
+      const Discretization<dim> &
+      discretization() const
+      {
+        return disc;
+      }
+      const EbfWaveAbc<dim> &
+      absorbing_boundary() const
+      {
+        return abc;
+      }
+      const Vector &
+      displacement() const
+      {
+        return u;
+      }
+      /** The dispersion relation used by the ABC (after setup with absorbing). */
+      const WaveDispersion<dim> &
+      dispersion() const
+      {
+        return *relation;
+      }
+      /** Wall seconds in the ABC update and in the whole of advance(). */
+      double abc_seconds = 0., step_seconds = 0.;
+
+    private:
+      Discretization<dim>                     disc;
+      std::unique_ptr<DiffusionOperator<dim>> op;
+      std::unique_ptr<WaveDispersion<dim>>    relation;
+      EbfWaveAbc<dim>                         abc;
+      Vector                                  u, v, a, Lu;
+      std::vector<double>                     u_old, v_old, u_abc, v_abc;
+      std::vector<double>                     bond_kernel_weight;
+      double                                  dt = 0., t = 0., d = 0.;
+      bool                                    absorbing = false;
+    };
+  } // namespace Abc
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,742 @@
+#include <deal.II/base/quadrature_lib.h>
+
+#include <boost/math/special_functions/bessel.hpp>
+
+#include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/base/exceptions.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace PeriDEAL
+{
+  namespace Abc
+  {
+    void
+    WaveAbcParameters::declare_parameters(ParameterHandler &prm)
+    {
+      prm.declare_entry("Number of wave numbers", "10", Patterns::Integer(1, 200),
+                        "n_k: subdivisions of [-Delta k, Delta k] (n_k + 1 wave numbers, (4.98)).");
+      prm.declare_entry("Wave number range", "1", Patterns::Double(0.),
+                        "Delta k (4.56); 0 < Delta k <= pi/dx (4.83).");
+      prm.declare_entry("Number of directions", "10", Patterns::Integer(0, 100),
+                        "n_phi: subdivisions of [-Delta phi, Delta phi] (2D).");
+      prm.declare_entry("Direction range", "0.785398163397448", Patterns::Double(0., M_PI / 2.),
+                        "Delta phi of the mode directions (4.56).");
+      prm.declare_entry("Cone angle", "0.785398163397448", Patterns::Double(0., M_PI / 2.),
+                        "Delta phi of the conic extrapolation region (4.86).");
+      prm.declare_entry("Cloud radius", "0", Patterns::Double(0.),
+                        "d_inf (0: the horizon for PD, 2 dx for FEM).");
+      prm.declare_entry("Layer thickness", "0", Patterns::Double(0.),
+                        "PD absorbing layer delta_L (0: the horizon).");
+      prm.declare_entry("Dispersion relation", "discrete",
+                        Patterns::Selection("local|nonlocal|discrete"),
+                        "local (4.39), continuum nonlocal (4.47/4.51/4.90) or discrete (4.85/4.95).");
+      prm.declare_entry("Maximum condition number", "1e12", Patterns::Double(1.),
+                        "Guard on the moment matrices.");
+      prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
+                        "Guard on max_j |V_j| (Sect. 4.2.3).");
+      prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
+                        "Relative singular-value cutoff of M^+ (0: max(rows, cols) * machine epsilon).");
+    }
+
+    void
+    WaveAbcParameters::parse_parameters(ParameterHandler &prm)
+    {
+      n_wave_numbers       = prm.get_integer("Number of wave numbers");
+      wave_number_range    = prm.get_double("Wave number range");
+      n_directions         = prm.get_integer("Number of directions");
+      direction_range      = prm.get_double("Direction range");
+      cone_angle           = prm.get_double("Cone angle");
+      cloud_radius         = prm.get_double("Cloud radius");
+      layer_thickness      = prm.get_double("Layer thickness");
+      dispersion           = prm.get("Dispersion relation");
+      max_condition_number = prm.get_double("Maximum condition number");
+      max_update_norm      = prm.get_double("Maximum updating vector norm");
+      pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
+    }
+
+
+    template <int dim>
+    WaveDispersion<dim>
+    WaveDispersion<dim>::local(const double chi, const double damping)
+    {
+      WaveDispersion<dim> w;
+      w.name    = "local";
+      w.damping = damping;
+      w.omega2  = [chi](const Tensor<1, dim> &k) { return chi * chi * (k * k); };
+      return w;
+    }
+
+    template <int dim>
+    WaveDispersion<dim>
+    WaveDispersion<dim>::nonlocal(const ScalarKernel &kernel, const double damping)
+    {
+      static_assert(dim <= 2, "1D and 2D only");
+      WaveDispersion<dim> w;
+      w.name    = "nonlocal";
+      w.damping = damping;
+      // Radial composite Gauss rule on [0, delta] (8 panels of 10 points):
+      // the integrand k(r) r^(dim-1) A(|k| r) with A = O((kr)^2) is smooth.
+      const QGauss<1>     gauss(10);
+      std::vector<double> r, wq;
+      const unsigned int  n_panels = 8;
+      for (unsigned int p = 0; p < n_panels; ++p)
+        for (unsigned int q = 0; q < gauss.size(); ++q)
+          {
+            r.push_back((p + gauss.point(q)[0]) * kernel.delta / n_panels);
+            wq.push_back(gauss.weight(q) * kernel.delta / n_panels);
+          }
+      w.omega2 = [kernel, r, wq](const Tensor<1, dim> &kv) {
+        const double k = kv.norm();
+        double       s = 0.;
+        for (unsigned int q = 0; q < r.size(); ++q)
+          {
+            const double x = k * r[q];
+            // Angular integral of 1 - cos(k r n.e) over the unit sphere.
+            const double angular =
+              dim == 1 ? 2. * (1. - std::cos(x)) :
+                         (std::abs(x) < 1e-4 ? 2. * M_PI * x * x / 4. :
+                                               2. * M_PI * (1. - boost::math::cyl_bessel_j(0, x)));
+            s += wq[q] * kernel(r[q]) * std::pow(r[q], double(dim) - 1.) * angular;
+          }
+        return s;
+      };
+      return w;
+    }
+
+    template <int dim>
+    WaveDispersion<dim>
+    WaveDispersion<dim>::stencil(const std::vector<Tensor<1, dim>> &offsets,
+                                 const std::vector<double>         &weights,
+                                 const double                       damping,
+                                 const std::string                 &name)
+    {
+      AssertDimension(offsets.size(), weights.size());
+      WaveDispersion<dim> w;
+      w.name    = name;
+      w.damping = damping;
+      w.omega2  = [offsets, weights](const Tensor<1, dim> &k) {
+        double s = 0.;
+        for (unsigned int j = 0; j < offsets.size(); ++j)
+          s += weights[j] * (1. - std::cos(k * offsets[j]));
+        return s;
+      };
+      return w;
+    }
+
+    template <int dim>
+    WaveDispersion<dim>
+    WaveDispersion<dim>::discrete(const ScalarKernel &kernel,
+                                  const double        dx,
+                                  const bool          partial_volume,
+                                  const double        damping)
+    {
+      // The lattice family of the origin exactly as the Discretization builds
+      // it (beta by Discretization::volume_factor, kernel at min(r, delta)).
+      const int                   m = static_cast<int>(std::ceil(kernel.delta / dx + 0.5)) + 1;
+      std::vector<Tensor<1, dim>> offsets;
+      std::vector<double>         weights;
+      std::array<int, dim>        l;
+      const unsigned int          n = 2 * m + 1;
+      unsigned int                total = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        total *= n;
+      for (unsigned int c = 0; c < total; ++c)
+        {
+          unsigned int   cc = c;
+          Tensor<1, dim> xi;
+          for (unsigned int d = 0; d < dim; ++d, cc /= n)
+            {
+              l[d]  = int(cc % n) - m;
+              xi[d] = l[d] * dx;
+            }
+          const double r = xi.norm();
+          if (r == 0.)
+            continue;
+          const double beta =
+            Discretization<dim>::volume_factor(r, kernel.delta, dx, partial_volume);
+          if (beta <= 0.)
+            continue;
+          offsets.push_back(xi);
+          weights.push_back(kernel(std::min(r, kernel.delta)) * beta * std::pow(dx, dim));
+        }
+      return stencil(offsets, weights, damping, "discrete");
+    }
+
+    template <int dim>
+    std::complex<double>
+    WaveDispersion<dim>::frequency(const double k, const Tensor<1, dim> &n) const
+    {
+      const std::complex<double> root =
+        std::sqrt(std::complex<double>(omega2(std::abs(k) * n) - damping * damping, 0.));
+      return k < 0 ? -root : root;
+    }
+
+
+    template <int dim>
+    Tensor<2, dim>
+    EbfWaveAbc<dim>::local_frame(const Tensor<1, dim> &n_in)
+    {
+      const Tensor<1, dim> n = n_in / n_in.norm();
+      Tensor<2, dim>       R;
+      if (dim == 1)
+        R[0][0] = n[0] > 0 ? 1. : -1.;
+      else
+        {
+          // Rows: the normal (x bar) and the tangent (y bar), Fig. 4.20.
+          R[0][0] = n[0];
+          R[0][1] = n[1];
+          R[1][0] = -n[1];
+          R[1][1] = n[0];
+        }
+      return R;
+    }
+
+    namespace
+    {
+      using CMatrix = Eigen::MatrixXcd;
+      using CRow    = Eigen::RowVectorXcd;
+
+      /** max_j |Re V_j| and condition number of one moment matrix fit. */
+      struct Fit
+      {
+        Eigen::RowVectorXd V;
+        double             cond = 0., vmax = 0.;
+      };
+
+      Fit
+      fit(const CMatrix &M, const CRow &psi, const double tolerance)
+      {
+        // One SVD gives both the Moore-Penrose inverse and the condition
+        // number. Without a tolerance, Eigen's default rank threshold
+        // (max(rows, cols) * epsilon relative to sigma_max) is used.
+        Fit                           f;
+        const Eigen::BDCSVD<CMatrix>  svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
+        const auto                   &sv  = svd.singularValues();
+        const double                  tol = tolerance > 0. ? tolerance :
+                                                             std::max(M.rows(), M.cols()) *
+                                                               std::numeric_limits<double>::epsilon();
+        Eigen::Index rank = 0;
+        while (rank < sv.size() && sv[rank] > tol * sv[0])
+          ++rank;
+        const CRow Vc = ((psi * svd.matrixV().leftCols(rank)) *
+                         sv.head(rank).cwiseInverse().asDiagonal()) *
+                        svd.matrixU().leftCols(rank).adjoint();
+        // Conjugate-closed mode sets and real data: V is real (the imaginary
+        // part is round-off).
+        f.V    = Vc.real();
+        f.cond = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
+        f.vmax = Vc.cwiseAbs().maxCoeff();
+        return f;
+      }
+    } // namespace
+
+    template <int dim>
+    void
+    EbfWaveAbc<dim>::reinit(const std::vector<Point<dim>>              &points,
+                            const std::vector<types::global_dof_index> &ids,
+                            const std::vector<unsigned int>            &absorbing_in,
+                            const std::vector<Tensor<1, dim>>          &normals,
+                            const WaveDispersion<dim>                  &dispersion,
+                            const double                                dt,
+                            const double                                dx,
+                            const WaveAbcParameters                    &prm,
+                            const MPI_Comm                              comm)
+    {
+      AssertDimension(points.size(), ids.size());
+      AssertDimension(absorbing_in.size(), normals.size());
+      check_parameter(prm.wave_number_range > 0. && prm.wave_number_range <= M_PI / dx * (1. + 1e-12),
+                      "Absorbing boundary/Wave number range", prm.wave_number_range,
+                      "0 < Delta k <= pi/dx = " + std::to_string(M_PI / dx) + " (4.83)");
+      check_parameter(prm.cloud_radius > 0., "Absorbing boundary/Cloud radius", prm.cloud_radius,
+                      "> 0");
+      absorbing = absorbing_in;
+      cloud_start.assign(1, 0);
+      cloud_index.clear();
+      vg_now.clear();
+      vg_old.clear();
+      vh_now.clear();
+      vh_old.clear();
+      stats = WaveCloudStatistics();
+
+      // Mode parameters (4.56), (4.98): k_m and phi_l in the local frame.
+      std::vector<double> k, phi;
+      for (unsigned int m = 0; m <= prm.n_wave_numbers; ++m)
+        k.push_back(prm.wave_number_range * (-1. + 2. * m / prm.n_wave_numbers));
+      if (dim == 1 || prm.n_directions == 0)
+        phi.push_back(0.);
+      else
+        for (unsigned int l = 0; l <= prm.n_directions; ++l)
+          phi.push_back(prm.direction_range * (-1. + 2. * l / prm.n_directions));
+      const unsigned int n_modes = k.size() * phi.size();
+      stats.n_modes              = n_modes;
+
+      const double r = prm.cloud_radius;
+      std::map<std::array<long, dim>, std::vector<unsigned int>> bins;
+      // Bins slightly wider than d_inf, so that points at distance d_inf up
+      // to round-off are in the neighbouring bins.
+      const double w      = r * (1. + 1e-6);
+      const auto   bin_of = [w](const Point<dim> &p) {
+        std::array<long, dim> b;
+        for (unsigned int d = 0; d < dim; ++d)
+          b[d] = static_cast<long>(std::floor(p[d] / w));
+        return b;
+      };
+      for (unsigned int i = 0; i < points.size(); ++i)
+        bins[bin_of(points[i])].push_back(i);
+      // (4.86): pi/2 + Delta phi < arg(x bar) < 3 pi/2 - Delta phi, i.e.
+      // x bar < 0 and |y bar| < cot(Delta phi) |x bar|.
+      const double cone_slope = 1. / std::tan(std::max(prm.cone_angle, 1e-12));
+
+      double       max_cond = 0., max_norm = 0.;
+      unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
+      unsigned int n_thinned = 0, max_stride = 1;
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        {
+          const unsigned int   i  = absorbing[a];
+          const Point<dim>    &xi = points[i];
+          const Tensor<2, dim> R  = local_frame(normals[a]);
+          // Global modal directions n_l = R^T (cos phi_l, sin phi_l).
+          std::vector<Tensor<1, dim>> dir_local(phi.size()), dir_global(phi.size());
+          for (unsigned int l = 0; l < phi.size(); ++l)
+            {
+              dir_local[l][0] = std::cos(phi[l]);
+              if (dim == 2)
+                dir_local[l][dim - 1] = std::sin(phi[l]);
+              dir_global[l] = transpose(R) * dir_local[l];
+            }
+          std::vector<std::complex<double>> omega(n_modes);
+          for (unsigned int l = 0; l < phi.size(); ++l)
+            for (unsigned int m = 0; m < k.size(); ++m)
+              omega[l * k.size() + m] = dispersion.frequency(k[m], dir_global[l]);
+          const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int l,
+                                const unsigned int m) {
+            const std::complex<double> I(0., 1.);
+            return std::exp(-dispersion.damping * time + I * k[m] * (dir_local[l] * xbar) -
+                            I * omega[l * k.size() + m] * time);
+          };
+          const auto mode_rate = [&](const unsigned int l, const unsigned int m) {
+            return -dispersion.damping - std::complex<double>(0., 1.) * omega[l * k.size() + m];
+          };
+
+          // Candidates: x_i and the points of the cone within d_inf.
+          std::vector<std::pair<unsigned int, Tensor<1, dim>>> cone;
+          cone.emplace_back(i, Tensor<1, dim>());
+          const auto         b0 = bin_of(xi);
+          const unsigned int n_neighbour_bins = dim == 1 ? 3 : 9;
+          for (unsigned int nb = 0; nb < n_neighbour_bins; ++nb)
+            {
+              auto         b = b0;
+              unsigned int c = nb;
+              for (unsigned int d = 0; d < dim; ++d, c /= 3)
+                b[d] += long(c % 3) - 1;
+              const auto it = bins.find(b);
+              if (it == bins.end())
+                continue;
+              for (const unsigned int j : it->second)
+                {
+                  if (j == i || xi.distance(points[j]) > r * (1. + 1e-10))
+                    continue;
+                  const Tensor<1, dim> xbar = R * (points[j] - xi);
+                  const double         lat  = dim == 2 ? std::abs(xbar[dim - 1]) : 0.;
+                  if (xbar[0] < -1e-10 * dx && lat < cone_slope * (-xbar[0]) * (1. - 1e-10))
+                    cone.emplace_back(j, xbar);
+                }
+            }
+          std::sort(cone.begin() + 1, cone.end(), [&ids](const auto &p, const auto &q) {
+            return ids[p.first] < ids[q.first];
+          });
+
+          std::ostringstream name;
+          name << "absorbing node " << ids[i] << " at (" << xi << ")";
+          Fit          fg, fh;
+          bool         ok = false;
+          unsigned int stride = 1;
+          std::vector<std::pair<unsigned int, Tensor<1, dim>>> cloud;
+          for (; stride <= 8 && !ok; ++stride)
+            {
+              // Auxiliary grid of spacing stride * dx in the local frame
+              // (Fig. 4.23); keep the candidate nearest to each auxiliary node.
+              cloud.assign(1, cone[0]);
+              if (stride == 1)
+                cloud = cone;
+              else
+                {
+                  std::set<unsigned int> taken{0};
+                  const double           hs = stride * dx;
+                  const int              na = int(std::floor(r / hs + 1e-9));
+                  for (int ax = 1; ax <= na; ++ax)
+                    for (int ay = (dim == 2 ? -na : 0); ay <= (dim == 2 ? na : 0); ++ay)
+                      {
+                        Tensor<1, dim> g;
+                        g[0] = -ax * hs;
+                        if (dim == 2)
+                          g[dim - 1] = ay * hs;
+                        if (g.norm() > r * (1. + 1e-10) ||
+                            (dim == 2 && std::abs(g[dim - 1]) >= cone_slope * ax * hs))
+                          continue;
+                        unsigned int best = 0;
+                        double       dist = std::numeric_limits<double>::max();
+                        for (unsigned int c = 1; c < cone.size(); ++c)
+                          {
+                            const double dd = (cone[c].second - g).norm();
+                            if (dd < dist - 1e-12 * dx)
+                              {
+                                dist = dd;
+                                best = c;
+                              }
+                          }
+                        if (best > 0 && dist < 0.5 * hs && taken.insert(best).second)
+                          cloud.push_back(cone[best]);
+                      }
+                  std::sort(cloud.begin() + 1, cloud.end(), [&ids](const auto &p, const auto &q) {
+                    return ids[p.first] < ids[q.first];
+                  });
+                }
+              if (cloud.size() < 2)
+                break;
+              // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt).
+              CMatrix MG(2 * cloud.size(), n_modes), MH(2 * cloud.size(), n_modes);
+              CRow    psi_g(n_modes), psi_h(n_modes);
+              for (unsigned int l = 0; l < phi.size(); ++l)
+                for (unsigned int m = 0; m < k.size(); ++m)
+                  {
+                    const unsigned int c = l * k.size() + m;
+                    psi_g[c]             = mode(Tensor<1, dim>(), dt, l, m);
+                    psi_h[c]             = mode_rate(l, m) * psi_g[c];
+                    for (unsigned int j = 0; j < cloud.size(); ++j)
+                      for (unsigned int s = 0; s < 2; ++s)
+                        {
+                          MG(2 * j + s, c) = mode(cloud[j].second, -double(s) * dt, l, m);
+                          MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
+                        }
+                  }
+              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance);
+              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance);
+              ok = fg.cond <= prm.max_condition_number && fh.cond <= prm.max_condition_number &&
+                   fg.vmax <= prm.max_update_norm && fh.vmax <= prm.max_update_norm;
+            }
+          --stride;
+          if (!ok)
+            {
+              std::ostringstream v;
+              v << "condition numbers " << fg.cond << " (M_G), " << fh.cond << " (M_H), max |V_G| "
+                << fg.vmax << ", max |V_H| " << fh.vmax << " for the " << name.str() << " ("
+                << cloud.size() << " cloud points at the last thinning stride " << stride << ", "
+                << n_modes << " modes)";
+              throw ParameterError("Absorbing boundary/Wave number range, Number of wave numbers",
+                                   v.str(),
+                                   "a mode set with condition number <= " +
+                                     std::to_string(prm.max_condition_number) +
+                                     " and max |V| <= " + std::to_string(prm.max_update_norm) +
+                                     " after thinning (reduce Delta k or the number of modes)");
+            }
+          if (stride > 1)
+            ++n_thinned;
+          max_stride = std::max(max_stride, stride);
+          max_cond   = std::max({max_cond, fg.cond, fh.cond});
+          max_norm   = std::max({max_norm, fg.vmax, fh.vmax});
+          min_size   = std::min<unsigned int>(min_size, cloud.size());
+          max_size   = std::max<unsigned int>(max_size, cloud.size());
+          for (unsigned int j = 0; j < cloud.size(); ++j)
+            {
+              cloud_index.push_back(cloud[j].first);
+              vg_now.push_back(fg.V[2 * j]);
+              vg_old.push_back(fg.V[2 * j + 1]);
+              vh_now.push_back(fh.V[2 * j]);
+              vh_old.push_back(fh.V[2 * j + 1]);
+            }
+          cloud_start.push_back(cloud_index.size());
+        }
+      all_cloud_points = cloud_index;
+      std::sort(all_cloud_points.begin(), all_cloud_points.end());
+      all_cloud_points.erase(std::unique(all_cloud_points.begin(), all_cloud_points.end()),
+                             all_cloud_points.end());
+      stats.n_absorbing = Utilities::MPI::sum<types::global_dof_index>(absorbing.size(), comm);
+      stats.max_condition_number = Utilities::MPI::max(max_cond, comm);
+      stats.max_update_norm      = Utilities::MPI::max(max_norm, comm);
+      stats.min_cloud_size       = Utilities::MPI::min(min_size, comm);
+      stats.max_cloud_size       = Utilities::MPI::max(max_size, comm);
+      stats.n_thinned            = Utilities::MPI::sum(n_thinned, comm);
+      stats.max_stride           = Utilities::MPI::max(max_stride, comm);
+    }
+
+    template <int dim>
+    void
+    EbfWaveAbc<dim>::compute(const double        *u,
+                             const double        *u_old,
+                             const double        *v,
+                             const double        *v_old,
+                             std::vector<double> &u_new,
+                             std::vector<double> &v_new) const
+    {
+      u_new.resize(absorbing.size());
+      v_new.resize(absorbing.size());
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        {
+          double su = 0., sv = 0.;
+          for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+            {
+              const unsigned int j = cloud_index[c];
+              su += vg_now[c] * u[j] + vg_old[c] * u_old[j];
+              sv += vh_now[c] * v[j] + vh_old[c] * v_old[j];
+            }
+          u_new[a] = su;
+          v_new[a] = sv;
+        }
+    }
+
+    template <int dim>
+    std::vector<unsigned int>
+    EbfWaveAbc<dim>::cloud(const unsigned int a) const
+    {
+      return std::vector<unsigned int>(cloud_index.begin() + cloud_start[a],
+                                       cloud_index.begin() + cloud_start[a + 1]);
+    }
+
+
+    template <int dim>
+    PdUnboundedWave<dim>::PdUnboundedWave(const MPI_Comm comm)
+      : disc(comm)
+    {}
+
+    template <int dim>
+    void
+    PdUnboundedWave<dim>::setup(const Domain<dim>          &domain,
+                                const LatticeParameters    &lattice,
+                                const ScalarWaveParameters &model,
+                                const WaveTruncation        boundary,
+                                const WaveAbcParameters    &prm_in,
+                                const Function<dim>        &initial)
+    {
+      check_parameter(domain.has_signed_distance(), "Geometry/Domain", "without signed distance",
+                      "a box or a ball (the absorbing layer needs the distance to the boundary)");
+      check_parameter(model.damping >= 0., "Model/Damping", model.damping, ">= 0");
+      disc.setup(domain, lattice);
+      // The operator and the time-step check of the PD wave solver.
+      ScalarWaveParameters mp = model;
+      {
+        ScalarKernel kern;
+        kern.dim      = dim;
+        kern.omega    = model.omega;
+        kern.exponent = model.exponent;
+        kern.delta    = lattice.delta;
+        if (mp.micro_constant <= 0.)
+          mp.micro_constant = kern.micro_constant_for(model.wave_speed * model.wave_speed);
+      }
+      DiffusionModelParameters dp;
+      dp.type              = "diffusion";
+      dp.omega             = model.omega;
+      dp.exponent          = model.exponent;
+      dp.micro_diffusivity = mp.micro_constant;
+      op                   = std::make_unique<DiffusionOperator<dim>>(disc, dp);
+      const double dt_crit = 2. / std::sqrt(2. / op->critical_time_step());
+      check_parameter(model.time_step > 0. && model.time_step <= dt_crit, "Time stepping/Time step",
+                      model.time_step, "0 < dt <= " + std::to_string(dt_crit) +
+                                         " (velocity-Verlet bound of the PD operator)");
+      dt = model.time_step;
+      d  = model.damping;
+      t  = 0.;
+      for (Vector *x : {&u, &v, &a, &Lu})
+        disc.initialize_vector(*x);
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        u.local_element(i) = initial.value(disc.position[i]);
+      const auto &nb = disc.neighborhood;
+      bond_kernel_weight.resize(nb.bond_length.size());
+      const ScalarKernel &kern = op->kernel();
+      for (std::size_t e = 0; e < bond_kernel_weight.size(); ++e)
+        bond_kernel_weight[e] = kern(std::min(nb.bond_length[e], kern.delta)) * nb.bond_weight[e];
+
+      u.update_ghost_values();
+      v.update_ghost_values();
+      op->apply(u, Lu);
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        a.local_element(i) = Lu.local_element(i);
+      const unsigned int n_local = disc.n_owned() + disc.n_ghost();
+      u_old.assign(u.begin(), u.begin() + n_local);
+      v_old.assign(v.begin(), v.begin() + n_local);
+
+      absorbing = boundary == WaveTruncation::absorbing;
+      if (prm_in.dispersion == "local")
+        relation = std::make_unique<WaveDispersion<dim>>(
+          WaveDispersion<dim>::local(model.wave_speed, d));
+      else if (prm_in.dispersion == "nonlocal")
+        relation = std::make_unique<WaveDispersion<dim>>(WaveDispersion<dim>::nonlocal(kern, d));
+      else
+        relation = std::make_unique<WaveDispersion<dim>>(
+          WaveDispersion<dim>::discrete(kern, lattice.dx, lattice.partial_volume, d));
+      if (!absorbing)
+        return;
+
+      WaveAbcParameters prm = prm_in;
+      const double      delta = lattice.delta;
+      if (prm.cloud_radius <= 0.)
+        prm.cloud_radius = delta;
+      const double layer = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
+      check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
+                      prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
+      check_parameter(layer >= lattice.dx * (1. - 1e-12), "Absorbing boundary/Layer thickness",
+                      layer, ">= dx (at least one node layer)");
+      const double                h = 1e-3 * lattice.dx;
+      std::vector<unsigned int>   nodes;
+      std::vector<Tensor<1, dim>> normals;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          const Point<dim> &x = disc.position[i];
+          if (-domain.signed_distance(x) < layer - 1e-8 * lattice.dx)
+            {
+              Tensor<1, dim> n;
+              for (unsigned int dd = 0; dd < dim; ++dd)
+                {
+                  Point<dim> xp = x, xm = x;
+                  xp[dd] += h;
+                  xm[dd] -= h;
+                  n[dd] = domain.signed_distance(xp) - domain.signed_distance(xm);
+                }
+              nodes.push_back(i);
+              normals.push_back(n / n.norm());
+            }
+        }
+      std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
+      abc.reinit(disc.position, ids, nodes, normals, *relation, dt, lattice.dx, prm,
+                 disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    void
+    PdUnboundedWave<dim>::advance()
+    {
+      using clock        = std::chrono::steady_clock;
+      const auto   start = clock::now();
+      const auto  &nodes = abc.absorbing_points();
+      const double half  = 0.5 * dt;
+      // (4.82) from the levels n and n-1 (ghosts of u, v are current).
+      if (absorbing)
+        {
+          abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
+          for (const unsigned int j : abc.cloud_points())
+            {
+              u_old[j] = u.begin()[j];
+              v_old[j] = v.begin()[j];
+            }
+        }
+      const auto abc_end = clock::now();
+      double    *uu = u.begin(), *vv = v.begin(), *aa = a.begin();
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          uu[i] += dt * (vv[i] + half * aa[i]);
+          vv[i] += half * aa[i];
+        }
+      for (unsigned int c = 0; c < nodes.size(); ++c)
+        uu[nodes[c]] = u_abc[c];
+      t += dt;
+      u.update_ghost_values();
+      op->apply(u, Lu);
+      const double  scale = 1. / (1. + dt * d);
+      const double *lu    = Lu.begin();
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          vv[i] = scale * (vv[i] + half * lu[i]);
+          aa[i] = lu[i] - 2. * d * vv[i];
+        }
+      const auto set_start = clock::now();
+      for (unsigned int c = 0; c < nodes.size(); ++c)
+        vv[nodes[c]] = v_abc[c];
+      if (absorbing)
+        v.update_ghost_values();
+      const auto end = clock::now();
+      abc_seconds += std::chrono::duration<double>(abc_end - start + end - set_start).count();
+      step_seconds += std::chrono::duration<double>(end - start).count();
+    }
+
+    template <int dim>
+    double
+    PdUnboundedWave<dim>::energy(const std::function<bool(const Point<dim> &)> &inside) const
+    {
+      const auto   &nb = disc.neighborhood;
+      const double *uu = u.begin();
+      double        e  = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          if (!inside(disc.position[i]))
+            continue;
+          const double *w   = bond_kernel_weight.data() + nb.table_start[i];
+          double        row = 0.;
+          for (std::uint64_t q = nb.row_start[i]; q < nb.row_start[i + 1]; ++q)
+            {
+              const double du = uu[nb.col[q]] - uu[i];
+              row += w[q - nb.row_start[i]] * du * du;
+            }
+          const double vi = v.local_element(i);
+          e += (0.5 * vi * vi + 0.25 * row) * disc.volume[i];
+        }
+      return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    double
+    PdUnboundedWave<dim>::value_at(const Point<dim> &p) const
+    {
+      double       best = std::numeric_limits<double>::max(), value = 0.;
+      unsigned int best_id = 0;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          const double dd = p.distance(disc.position[i]);
+          if (dd < best - 1e-12)
+            {
+              best    = dd;
+              value   = u.local_element(i);
+              best_id = disc.id[i];
+            }
+        }
+      const MPI_Comm comm   = disc.get_mpi_communicator();
+      const double   global = Utilities::MPI::min(best, comm);
+      // The owner of the nearest node (lowest id on ties) reports its value.
+      const unsigned int owner_id = Utilities::MPI::min(
+        std::abs(best - global) <= 1e-12 ? best_id : std::numeric_limits<unsigned int>::max(), comm);
+      return Utilities::MPI::sum(
+        (std::abs(best - global) <= 1e-12 && best_id == owner_id) ? value : 0., comm);
+    }
+
+    template <int dim>
+    std::vector<std::pair<Point<dim>, double>>
+    PdUnboundedWave<dim>::gather(const std::function<bool(const Point<dim> &)> &inside) const
+    {
+      std::vector<double> local;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (inside(disc.position[i]))
+          {
+            for (unsigned int dd = 0; dd < dim; ++dd)
+              local.push_back(disc.position[i][dd]);
+            local.push_back(u.local_element(i));
+          }
+      const auto all = Utilities::MPI::all_gather(disc.get_mpi_communicator(), local);
+      std::vector<std::pair<Point<dim>, double>> out;
+      for (const auto &chunk : all)
+        for (std::size_t q = 0; q + dim < chunk.size(); q += dim + 1)
+          {
+            Point<dim> p;
+            for (unsigned int dd = 0; dd < dim; ++dd)
+              p[dd] = chunk[q + dd];
+            out.emplace_back(p, chunk[q + dim]);
+          }
+      return out;
+    }
+
+    template class WaveDispersion<1>;
+    template class WaveDispersion<2>;
+    template class EbfWaveAbc<1>;
+    template class EbfWaveAbc<2>;
+    template class PdUnboundedWave<1>;
+    template class PdUnboundedWave<2>;
+  } // namespace Abc
+} // namespace PeriDEAL

@@ -1,0 +1,225 @@
+// step-7: PD scalar waves on unbounded domains with EBF absorbing boundary
+// conditions (dissertation Sect. 4.2.4 and 4.2.6).
+//
+// The idea of this step: the near field is truncated to a disc (2D) or an
+// interval (1D); the nodes within delta of the truncation boundary get their
+// displacement and velocity at t^{n+1} extrapolated from their clouds at
+// t^n and t^{n-1} with outgoing complex harmonic modes
+// exp(-d t) exp(i k n.x - i w(k) t) (4.57), through precomputed updating
+// vectors (4.82). The modes carry either the discrete PD dispersion relation
+// of the near field's own stencil (Proposed-A, (4.85)) or the local one
+// (Proposed-B, (4.39)). Each run is compared with the same code on an
+// extended domain whose boundary nothing reaches (the reference), and with
+// the free (untreated) truncation.
+//
+// 2D: u_tt = L u - 2 d u_t, p = 2, omega_0, chi = 1, d = 0.0125,
+// Delta k = 1, delta = 6 dx, u0 = exp(-log 2 |x|^2). 1D (E12b): p = 0,
+// delta = 0.6, dx = 0.2, (-10, 10) vs (-50, 50), u0 = exp(-x^2), dt = 1e-3,
+// Delta alpha = pi/2, n_b = 1..5.
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/base/exceptions.h>
+#include <perideal/io/plot.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEAL::Abc;
+
+namespace Step7
+{
+  struct Parameters
+  {
+    double       radius = 8., end_time = 16., dx = 0.25, dt = 0.02;
+    unsigned int horizon_factor = 6, n_samples = 16;
+    double       t_1d = 25.;
+    std::string  output_directory = "step-7-output";
+    WaveAbcParameters abc;
+  };
+
+  /** Energies (4.99) at the sample times of one run. */
+  template <int dim>
+  std::vector<double>
+  energies(const Domain<dim> &domain, const LatticeParameters &lp, const ScalarWaveParameters &mp,
+           const WaveTruncation trunc, const WaveAbcParameters &abc, const Function<dim> &u0,
+           const double t_end, const unsigned int n_samples,
+           const std::function<bool(const Point<dim> &)> &inside, std::string &stats)
+  {
+    PdUnboundedWave<dim> pd(MPI_COMM_WORLD);
+    pd.setup(domain, lp, mp, trunc, abc, u0);
+    const unsigned int  n_steps = static_cast<unsigned int>(std::round(t_end / mp.time_step));
+    std::vector<double> e;
+    for (unsigned int s = 0; s <= n_samples; ++s)
+      {
+        while (std::round(pd.time() / mp.time_step) < n_steps * s / n_samples)
+          pd.advance();
+        e.push_back(pd.energy(inside));
+      }
+    const auto &st = pd.absorbing_boundary().statistics();
+    std::ostringstream o;
+    o << st.n_absorbing << " absorbing nodes, " << st.n_modes << " modes, clouds "
+      << st.min_cloud_size << ".." << st.max_cloud_size << " (stride " << st.max_stride
+      << "), max cond " << st.max_condition_number << ", max |V| " << st.max_update_norm
+      << ", ABC time fraction " << pd.abc_seconds / std::max(pd.step_seconds, 1e-300);
+    stats = o.str();
+    return e;
+  }
+
+  int
+  run(const std::string &file)
+  {
+    Parameters p;
+    {
+      ParameterHandler prm;
+      prm.enter_subsection("Problem");
+      prm.declare_entry("Near-field radius", "8", Patterns::Double(0.));
+      prm.declare_entry("End time", "16", Patterns::Double(0.));
+      prm.declare_entry("Grid spacing", "0.25", Patterns::Double(0.));
+      prm.declare_entry("Time step", "0.02", Patterns::Double(0.));
+      prm.declare_entry("Horizon factor", "6", Patterns::Integer(1, 50));
+      prm.declare_entry("Number of samples", "16", Patterns::Integer(1, 10000));
+      prm.declare_entry("End time 1D", "25", Patterns::Double(0.));
+      prm.declare_entry("Output directory", "step-7-output", Patterns::Anything());
+      prm.leave_subsection();
+      prm.enter_subsection("Absorbing boundary");
+      WaveAbcParameters::declare_parameters(prm);
+      prm.leave_subsection();
+      prm.parse_input(file);
+      prm.enter_subsection("Problem");
+      p.radius           = prm.get_double("Near-field radius");
+      p.end_time         = prm.get_double("End time");
+      p.dx               = prm.get_double("Grid spacing");
+      p.dt               = prm.get_double("Time step");
+      p.horizon_factor   = prm.get_integer("Horizon factor");
+      p.n_samples        = prm.get_integer("Number of samples");
+      p.t_1d             = prm.get_double("End time 1D");
+      p.output_directory = prm.get("Output directory");
+      prm.leave_subsection();
+      prm.enter_subsection("Absorbing boundary");
+      p.abc.parse_parameters(prm);
+      prm.leave_subsection();
+    }
+    const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+    if (root)
+      std::filesystem::create_directories(p.output_directory);
+    int        failures = 0;
+    const auto check    = [&](const bool ok, const std::string &what) {
+      if (root)
+        std::cout << (ok ? "  ok    " : "  FAIL  ") << what << std::endl;
+      failures += ok ? 0 : 1;
+    };
+
+    // 2D: reference, free truncation, Proposed-A, Proposed-B.
+    {
+      LatticeParameters lp;
+      lp.dx    = p.dx;
+      lp.delta = p.horizon_factor * p.dx;
+      ScalarWaveParameters mp;
+      mp.damping   = 0.0125;
+      mp.time_step = p.dt;
+      const ScalarFunctionFromFunctionObject<2> u0(
+        [](const Point<2> &x) { return std::exp(-std::log(2.) * x.square()); });
+      const double R      = p.radius;
+      const auto   inside = [&](const Point<2> &x) { return x.norm() < R - lp.delta - 1e-9; };
+      // Nothing reflected at R_ref is back inside R - delta before t_end.
+      BallDomain<2> near(Point<2>(), R), far(Point<2>(), 0.5 * (p.end_time + R + 2.) + 3. + lp.delta);
+      std::string   s_ref, s_free, s_a, s_b;
+      const auto ref = energies<2>(far, lp, mp, WaveTruncation::free, p.abc, u0, p.end_time, p.n_samples, inside, s_ref);
+      const auto fr  = energies<2>(near, lp, mp, WaveTruncation::free, p.abc, u0, p.end_time, p.n_samples, inside, s_free);
+      WaveAbcParameters abc = p.abc;
+      abc.dispersion        = "discrete";
+      const auto A          = energies<2>(near, lp, mp, WaveTruncation::absorbing, abc, u0, p.end_time, p.n_samples, inside, s_a);
+      abc.dispersion        = "local";
+      const auto B          = energies<2>(near, lp, mp, WaveTruncation::absorbing, abc, u0, p.end_time, p.n_samples, inside, s_b);
+      if (root)
+        {
+          std::cout << "2D Proposed-A: " << s_a << "\n2D Proposed-B: " << s_b << std::endl;
+          std::ofstream out(p.output_directory + "/energy_2d.csv");
+          out << "t,reference,free,Proposed-A,Proposed-B,|A-ref|,|B-ref|,|free-ref|\n";
+          for (unsigned int s = 0; s < ref.size(); ++s)
+            out << p.end_time * s / p.n_samples << ',' << ref[s] / ref[0] << ',' << fr[s] / ref[0] << ','
+                << A[s] / ref[0] << ',' << B[s] / ref[0] << ',' << std::abs(A[s] - ref[s]) / ref[0] << ','
+                << std::abs(B[s] - ref[s]) / ref[0] << ',' << std::abs(fr[s] - ref[s]) / ref[0] << '\n';
+        }
+      const double ea = std::abs(A.back() - ref.back()) / ref[0], eb = std::abs(B.back() - ref.back()) / ref[0],
+                   ef = std::abs(fr.back() - ref.back()) / ref[0];
+      check(ea < eb, "2D: Proposed-A closer to the reference than Proposed-B at t_end (" + std::to_string(ea) + " vs " + std::to_string(eb) + ")");
+      check(10. * ea < ef, "2D: Proposed-A 10x closer than the free truncation (" + std::to_string(ea) + " vs " + std::to_string(ef) + ")");
+    }
+
+    // 1D (E12b): n_b study with the discrete and the local relation.
+    {
+      LatticeParameters lp;
+      lp.dx    = 0.2;
+      lp.delta = 0.6;
+      ScalarWaveParameters mp;
+      mp.exponent  = 0.;
+      mp.time_step = 1e-3;
+      const ScalarFunctionFromFunctionObject<1> u0([](const Point<1> &x) { return std::exp(-x[0] * x[0]); });
+      const auto   inside = [](const Point<1> &x) { return std::abs(x[0]) < 10. - 0.6 - 1e-9; };
+      BoxDomain<1> near(Point<1>(-10.), Point<1>(10.)), far(Point<1>(-50.), Point<1>(50.));
+      WaveAbcParameters abc = p.abc;
+      abc.wave_number_range = M_PI / 2.;
+      std::string s;
+      const unsigned int n = 100;
+      const auto ref  = energies<1>(far, lp, mp, WaveTruncation::free, abc, u0, p.t_1d, n, inside, s);
+      std::ofstream out;
+      if (root)
+        {
+          out.open(p.output_directory + "/modes_1d.csv");
+          out << "n_b,discrete,local\n";
+        }
+      for (unsigned int nb = 1; nb <= 5; ++nb)
+        {
+          double err[2];
+          for (unsigned int r = 0; r < 2; ++r)
+            {
+              abc.n_wave_numbers = nb;
+              abc.dispersion     = r == 0 ? "discrete" : "local";
+              const auto e       = energies<1>(near, lp, mp, WaveTruncation::absorbing, abc, u0, p.t_1d, n, inside, s);
+              err[r]             = 0.;
+              for (unsigned int k = 0; k < e.size(); ++k)
+                err[r] = std::max(err[r], std::abs(e[k] - ref[k]) / ref[0]);
+            }
+          if (root)
+            out << nb << ',' << err[0] << ',' << err[1] << '\n';
+        }
+    }
+
+    if (root)
+      {
+        std::ostringstream gp;
+        gp << gnuplot_png_preamble(p.output_directory + "/energy_2d.png")
+           << "set datafile separator ','\nset key autotitle columnhead top right\n"
+           << "set logscale y\nset yrange [1e-7:2]\nset xlabel 't'\n"
+           << "set ylabel 'E(t)/E_ref(0) and |E - E_ref|/E_ref(0) in r < R - delta'\n"
+           << "plot for [i=2:8] '" << p.output_directory << "/energy_2d.csv' using 1:i with linespoints lw 2\n";
+        run_gnuplot(p.output_directory + "/energy_2d.gp", gp.str(), p.output_directory + "/energy_2d.png");
+      }
+    return failures == 0 ? 0 : 1;
+  }
+} // namespace Step7
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  try
+    {
+      return Step7::run(argc > 1 ? argv[1] : "step-7.prm");
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "Error: " << e.what() << std::endl;
+      return 1;
+    }
+}
