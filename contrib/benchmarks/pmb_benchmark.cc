@@ -225,7 +225,7 @@ namespace
 
     // compute_forces alone (the state keeps evolving between the chunks
     // of the loop above; here u is frozen).
-    // The half list (set_half_list(true)) and the full list (the default: every bond
+    // The half list (the 3D default) and the full list (the 2D default: every bond
     // copy evaluated in its own row) are timed round robin, three rounds,
     // best of each: the machine is shared. Both count the same bond
     // updates (bonds = both copies of every bond), so the ratio is the
@@ -246,7 +246,7 @@ namespace
           best.wall    = std::min(best.wall, t.wall);
           best.cpu     = std::min(best.cpu, t.cpu);
         }
-    model.set_half_list(false);
+    model.set_half_list(dim == 3);
     double diff = 0., fmax = 0.;
     for (unsigned int d = 0; d < dim; ++d)
       for (unsigned int i = 0; i < disc->n_owned(); ++i)
@@ -256,9 +256,12 @@ namespace
         }
     diff = Utilities::MPI::max(diff, comm);
     fmax = Utilities::MPI::max(fmax, comm);
-    print("force_seconds", t_full.wall / steps);
-    print("force_bond_updates_per_s_per_core", bond_updates / (t_full.wall * n_ranks));
-    print("force_bond_updates_per_cpu_second", bond_updates / t_full.cpu);
+    const Timing &t_default = dim == 3 ? t_force : t_full; // the library's default loop
+    print("force_seconds", t_default.wall / steps);
+    print("force_bond_updates_per_s_per_core", bond_updates / (t_default.wall * n_ranks));
+    print("force_bond_updates_per_cpu_second", bond_updates / t_default.cpu);
+    print("force_full_list_bond_updates_per_s_per_core", bond_updates / (t_full.wall * n_ranks));
+    print("force_full_list_bond_updates_per_cpu_second", bond_updates / t_full.cpu);
     print("force_half_list_bond_updates_per_s_per_core", bond_updates / (t_force.wall * n_ranks));
     print("force_half_list_bond_updates_per_cpu_second", bond_updates / t_force.cpu);
     print("force_half_list_speedup_cpu", t_full.cpu / t_force.cpu);

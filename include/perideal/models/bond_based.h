@@ -162,8 +162,8 @@ namespace PeriDEAL
      * bonds whose stretch now exceeds s0 (their force is already zero).
      * @p u must have up-to-date ghost values.
      *
-     * By default every bond copy is evaluated in its own row (full list).
-     * Optionally (set_half_list()) a bond between two owned nodes is
+     * In 1D and 2D every bond copy is evaluated in its own row (full list)
+     * by default. With the half list (the 3D default, set_half_list()) a bond between two owned nodes is
      * evaluated once, in the row of the end point from which its lattice
      * offset is lexicographically positive, and its force is added to that
      * end and subtracted from the other (Newton's third law; valid because
@@ -177,12 +177,14 @@ namespace PeriDEAL
     compute_forces(const VectorField &u, VectorField &force);
 
     /**
-     * Select the half-list (true) or the full-list loop (default: every
-     * bond copy evaluated in its own row) of the nonlinear force. Both give
-     * the same forces and broken bonds up to round-off. The half list does
-     * half the bond evaluations but scatters each reaction to the
-     * neighbour; on the AMD Zen 5 benchmark machine both run at the same
-     * rate (doc/benchmarks.md), so the simpler full list is the default.
+     * Select the half-list (true) or the full-list loop (every bond copy
+     * evaluated in its own row) of the nonlinear force. Both give the same
+     * forces and broken bonds up to round-off. The half list does half the
+     * bond evaluations but adds each reaction to the neighbour's record. On
+     * the benchmark machine (AMD Zen 5, doc/benchmarks.md) it is 1.0-1.04x
+     * the full list's rate in 3D m = 3 and 1.3-1.4x in 3D m = 12, but
+     * 0.97-1.02x in 2D: the default is the half list in 3D, the full list in
+     * 1D and 2D.
      */
     void
     set_half_list(const bool use_half_list)
@@ -280,8 +282,8 @@ namespace PeriDEAL
      */
     std::vector<double> deformed;
 
-    /** Use the half list in compute_forces() (nonlinear branch). */
-    bool half_list = false;
+    /** Use the half list in compute_forces() (nonlinear branch); see set_half_list(). */
+    bool half_list = dim == 3;
     /**
      * Per owned row: bonds with a lexicographically positive lattice offset
      * (the half list) start at row_start[i] + half_offset[i] (the
