@@ -181,7 +181,7 @@ namespace PeriDEAL
      * evaluated in its own row) of the nonlinear force. Both give the same
      * forces and broken bonds up to round-off. The half list does half the
      * bond evaluations but adds each reaction to the neighbour's record. On
-     * the benchmark machine (AMD Zen 5, doc/benchmarks.md) it is 1.0-1.04x
+     * the benchmark machine (AMD Zen 5, doc/benchmarks.md) it is 0.97-1.04x
      * the full list's rate in 3D m = 3 and 1.3-1.4x in 3D m = 12, but
      * 0.97-1.02x in 2D: the default is the half list in 3D, the full list in
      * 1D and 2D.
