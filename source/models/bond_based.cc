@@ -4,6 +4,7 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/bond_based.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -153,6 +154,110 @@ namespace PeriDEAL
         row_stiffness[i] = s;
       }
     broken_flag.assign(nb.n_bonds(), 0);
+    setup_half_list();
+  }
+
+  template <int dim>
+  unsigned int
+  BondBasedOperator<dim>::box_index(const unsigned int i, const std::uint64_t b) const
+  {
+    const auto  &li = disc.lattice_index[i];
+    const auto  &lj = disc.lattice_index[disc.neighborhood.col[b]];
+    const int    W  = 2 * box_radius + 1;
+    unsigned int index = 0, stride = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        index += (lj[d] - li[d] + box_radius) * stride;
+        stride *= W;
+      }
+    return index;
+  }
+
+  template <int dim>
+  std::uint64_t
+  BondBasedOperator<dim>::mirror_bond(const unsigned int i, const std::uint64_t b) const
+  {
+    // Row j lists its bonds in increasing box index; the copy of bond b has
+    // the negated offset, i.e. the mirrored box index, and lies in j's
+    // negative half.
+    const auto        &nb     = disc.neighborhood;
+    const unsigned int j      = nb.col[b];
+    const unsigned int target = centre_index() * 2 - box_index(i, b);
+    std::uint64_t      lo = nb.row_start[j], hi = nb.row_start[j] + half_offset[j];
+    while (lo < hi)
+      {
+        const std::uint64_t mid = (lo + hi) / 2;
+        if (box_index(j, mid) < target)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+    AssertThrow(lo < nb.row_start[j + 1] && nb.col[lo] == std::int32_t(i),
+                ExcInternalError("The copy of a bond is missing in its neighbour's row."));
+    return lo;
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::setup_half_list()
+  {
+    const auto  &nb    = disc.neighborhood;
+    const double dx    = disc.parameters().dx;
+    const double delta = disc.parameters().delta;
+    box_radius = int(std::ceil((disc.parameters().partial_volume ? delta + 0.5 * dx : delta) / dx));
+    const unsigned int centre = centre_index();
+
+    half_offset.resize(disc.n_owned());
+    ghost_row.clear();
+    ghost_row_start.assign(1, 0);
+    ghost_bond.clear();
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i], end = nb.row_start[i + 1];
+        // Bonds are in increasing box index (stencil order): the positive
+        // offsets are a suffix.
+        std::uint64_t lo = begin, hi = end;
+        while (lo < hi)
+          {
+            const std::uint64_t mid = (lo + hi) / 2;
+            if (box_index(i, mid) < centre)
+              lo = mid + 1;
+            else
+              hi = mid;
+          }
+        half_offset[i] = lo - begin;
+        for (std::uint64_t b = begin; b < lo; ++b)
+          if (nb.col[b] >= std::int32_t(disc.n_owned()))
+            ghost_bond.push_back(b);
+        if (ghost_bond.size() > ghost_row_start.back())
+          {
+            ghost_row.push_back(i);
+            ghost_row_start.push_back(ghost_bond.size());
+          }
+      }
+    ghost_col.resize(ghost_bond.size());
+    ghost_stiffness.resize(ghost_bond.size());
+    ghost_length.resize(ghost_bond.size());
+    ghost_broken.resize(ghost_bond.size());
+    for (std::size_t g = 0; g < ghost_row.size(); ++g)
+      {
+        const unsigned int i = ghost_row[g];
+        for (std::uint64_t e = ghost_row_start[g]; e < ghost_row_start[g + 1]; ++e)
+          {
+            const std::uint64_t t = nb.table_start[i] + ghost_bond[e] - nb.row_start[i];
+            ghost_col[e]          = nb.col[ghost_bond[e]];
+            ghost_stiffness[e]    = bond_coefficient[t];
+            ghost_length[e]       = nb.bond_length[t];
+          }
+      }
+
+    // Newton's third law needs the same stiffness in both copies of a bond:
+    // the table entries of opposite stencil offsets (slots s and S-1-s).
+    const unsigned int S = nb.stencil_size;
+    for (unsigned int t = 0; t < S / 2; ++t)
+      AssertThrow(bond_coefficient[t] == bond_coefficient[S - 1 - t] &&
+                    nb.bond_length[t] == nb.bond_length[S - 1 - t],
+                  ExcInternalError("The bond stencil is not symmetric."));
   }
 
   template <int dim>
@@ -173,6 +278,15 @@ namespace PeriDEAL
     constexpr unsigned int record_size = dim == 3 ? 4 : dim;
 
     /**
+     * Doubles per node in the scratch of compute_forces(): the deformed
+     * position record, then the force record of the half list. A bond's
+     * neighbour load and its reaction update touch the same cache line
+     * (3D: one 64-byte line per node).
+     */
+    template <int dim>
+    constexpr unsigned int node_stride = 2 * record_size<dim>;
+
+    /**
      * One row of the nonlinear PMB force, portable version. p holds the
      * deformed positions x - x_c + u (records of record_size<dim>
      * doubles), k the bond stiffnesses c omega beta V / |xi| and r the
@@ -183,7 +297,33 @@ namespace PeriDEAL
      * correctly rounded expressions of y and -y (and the same table
      * values), so they see the same l and break together.
      */
-    template <int dim>
+    /**
+     * Where a half row sends the reaction of its bonds: the force records of
+     * all local nodes (subtract from the neighbour's record), and the list of
+     * newly broken bonds whose copy in an owned neighbour's row must be
+     * flagged too. A full row (Scatter = false) uses neither.
+     */
+    struct Reaction
+    {
+      double                     *force   = nullptr;
+      std::int32_t                n_owned = 0;
+      std::uint64_t               first_bond = 0; ///< CSR index of the row slice's bond 0
+      std::vector<std::uint64_t> *newly_broken = nullptr;
+    };
+
+    /**
+     * One row of the nonlinear PMB force, portable version. p holds the
+     * deformed positions x - x_c + u (records of record_size<dim>
+     * doubles), k the bond stiffnesses c omega beta V / |xi| and r the
+     * lengths |xi| of the row's table slice. With l = |y|, y = p_j - p_i,
+     * the force is k (l - r) y / l, i.e. c omega s beta V y / l with the
+     * stretch s = (l - r)/r (3.1); the bond breaks when l - r > s0 r, i.e.
+     * s > s0 (2.34). The two copies of a bond evaluate the same
+     * correctly rounded expressions of y and -y (and the same table
+     * values), so they see the same l and break together. With Scatter,
+     * -k (l - r) y / l goes to the neighbour's force record (half list).
+     */
+    template <int dim, bool Scatter>
     inline void
     pmb_row(const double       *p,
             const double       *pi,
@@ -193,13 +333,14 @@ namespace PeriDEAL
             std::uint8_t       *broken,
             const unsigned int  n,
             const double        s0,
-            double             *f)
+            double             *f,
+            const Reaction     &reaction)
     {
       for (unsigned int b = 0; b < n; ++b)
         {
           if (broken[b])
             continue;
-          const double *pj = p + std::size_t(record_size<dim>) * col[b];
+          const double *pj = p + std::size_t(node_stride<dim>) * col[b];
           double        y[dim];
           for (unsigned int d = 0; d < dim; ++d)
             y[d] = pj[d] - pi[d];
@@ -211,11 +352,18 @@ namespace PeriDEAL
           if (dl > s0 * r[b])
             {
               broken[b] = 1;
+              if (Scatter && col[b] < reaction.n_owned)
+                reaction.newly_broken->push_back(reaction.first_bond + b);
               continue;
             }
           const double scale = k[b] * dl / l;
           for (unsigned int d = 0; d < dim; ++d)
-            f[d] = std::fma(scale, y[d], f[d]);
+            {
+              const double t = scale * y[d];
+              f[d] += t;
+              if constexpr (Scatter)
+                reaction.force[std::size_t(node_stride<dim>) * col[b] + d] -= t;
+            }
         }
     }
 
@@ -239,10 +387,10 @@ namespace PeriDEAL
       const double *rec[8];
       if (b + 8 <= n)
         for (unsigned int q = 0; q < 8; ++q)
-          rec[q] = p + std::size_t(record_size<dim>) * col[b + q];
+          rec[q] = p + std::size_t(node_stride<dim>) * col[b + q];
       else
         for (unsigned int q = 0; q < 8; ++q)
-          rec[q] = b + q < n ? p + std::size_t(record_size<dim>) * col[b + q] : pi;
+          rec[q] = b + q < n ? p + std::size_t(node_stride<dim>) * col[b + q] : pi;
       if constexpr (dim == 2)
         {
           __m512d lo = _mm512_castpd128_pd512(_mm_loadu_pd(rec[0]));
@@ -277,13 +425,68 @@ namespace PeriDEAL
     }
 
     /**
+     * Subtract the eight dim vectors t (lane q: bond b+q) from the force
+     * records of the bonds' neighbours: the inverse of the transpose in
+     * load_bond_vectors(), then one 16/32-byte read-modify-write per bond.
+     * The columns of a row are distinct, so the lanes never collide.
+     */
+    template <int dim>
+    inline void
+    scatter_bond_vectors(double             *F,
+                         const std::int32_t *col,
+                         const unsigned int  n_lanes,
+                         const __m512d      *t)
+    {
+      constexpr unsigned int R = node_stride<dim>;
+      if constexpr (dim == 2)
+        {
+          const __m512d lo = _mm512_unpacklo_pd(t[0], t[1]); // x0 y0 x2 y2 x4 y4 x6 y6
+          const __m512d hi = _mm512_unpackhi_pd(t[0], t[1]); // x1 y1 x3 y3 ...
+          const __m128d v[8] = {_mm512_castpd512_pd128(lo),   _mm512_castpd512_pd128(hi),
+                                _mm512_extractf64x2_pd(lo, 1), _mm512_extractf64x2_pd(hi, 1),
+                                _mm512_extractf64x2_pd(lo, 2), _mm512_extractf64x2_pd(hi, 2),
+                                _mm512_extractf64x2_pd(lo, 3), _mm512_extractf64x2_pd(hi, 3)};
+          for (unsigned int q = 0; q < n_lanes; ++q)
+            {
+              double *dst = F + std::size_t(R) * col[q];
+              _mm_storeu_pd(dst, _mm_sub_pd(_mm_loadu_pd(dst), v[q]));
+            }
+        }
+      else
+        {
+          const __m512d zero = _mm512_setzero_pd();
+          const __m512d lo   = _mm512_unpacklo_pd(t[0], t[1]);
+          const __m512d hi   = _mm512_unpackhi_pd(t[0], t[1]);
+          const __m512d zlo  = _mm512_unpacklo_pd(t[2], zero); // z0 0 z2 0 ...
+          const __m512d zhi  = _mm512_unpackhi_pd(t[2], zero);
+          const __m512i a    = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
+          const __m512i c    = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+          const __m512d r02  = _mm512_permutex2var_pd(lo, a, zlo);
+          const __m512d r46  = _mm512_permutex2var_pd(lo, c, zlo);
+          const __m512d r13  = _mm512_permutex2var_pd(hi, a, zhi);
+          const __m512d r57  = _mm512_permutex2var_pd(hi, c, zhi);
+          const __m256d v[8] = {_mm512_castpd512_pd256(r02),    _mm512_castpd512_pd256(r13),
+                                _mm512_extractf64x4_pd(r02, 1), _mm512_extractf64x4_pd(r13, 1),
+                                _mm512_castpd512_pd256(r46),    _mm512_castpd512_pd256(r57),
+                                _mm512_extractf64x4_pd(r46, 1), _mm512_extractf64x4_pd(r57, 1)};
+          for (unsigned int q = 0; q < n_lanes; ++q)
+            {
+              double *dst = F + std::size_t(R) * col[q];
+              _mm256_storeu_pd(dst, _mm256_sub_pd(_mm256_loadu_pd(dst), v[q]));
+            }
+        }
+    }
+
+    /**
      * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
      * one accumulator per component reduced once per row. Every bond goes
      * through the same instructions (1/l from vrsqrt14pd and Newton steps,
-     * a few ulp from 1/sqrt), so the two copies of a bond still see
-     * bitwise the same l and break together.
+     * a few ulp from 1/sqrt; l - r by one explicit fused multiply-subtract),
+     * so the two copies of a bond, and the half-list and ghost-list
+     * evaluations of a bond on different ranks, see bitwise the same l and
+     * break together.
      */
-    template <int dim>
+    template <int dim, bool Scatter>
     inline void
     pmb_row_avx512(const double       *p,
                    const double       *pi,
@@ -293,7 +496,8 @@ namespace PeriDEAL
                    std::uint8_t       *broken,
                    const unsigned int  n,
                    const double        s0,
-                   double             *f)
+                   double             *f,
+                   const Reaction     &reaction)
     {
       __m512d acc[dim];
       for (unsigned int d = 0; d < dim; ++d)
@@ -322,22 +526,147 @@ namespace PeriDEAL
           for (unsigned int it = 0; it < 2; ++it)
             inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_halves));
           const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
-          const __m512d dl = _mm512_sub_pd(_mm512_mul_pd(l2, inv), rb);
+          const __m512d dl = _mm512_fmsub_pd(l2, inv, rb);
           const __mmask8 brk =
             _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
           const __mmask8 live = alive & ~brk;
           const __m512d  scale =
             _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), inv);
-          for (unsigned int d = 0; d < dim; ++d)
-            acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
+          if constexpr (Scatter)
+            {
+              __m512d t[dim];
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  t[d]   = _mm512_mul_pd(scale, y[d]);
+                  acc[d] = _mm512_add_pd(acc[d], t[d]);
+                }
+              scatter_bond_vectors<dim>(reaction.force, col + b, std::min(8u, n - b), t);
+            }
+          else
+            for (unsigned int d = 0; d < dim; ++d)
+              acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
           if (brk)
-            _mm_mask_storeu_epi8(broken + b, brk, _mm_set1_epi8(1));
+            {
+              _mm_mask_storeu_epi8(broken + b, brk, _mm_set1_epi8(1));
+              if constexpr (Scatter)
+                for (unsigned int q = 0; q < 8; ++q)
+                  if ((brk >> q) & 1u && col[b + q] < reaction.n_owned)
+                    reaction.newly_broken->push_back(reaction.first_bond + b + q);
+            }
         }
       for (unsigned int d = 0; d < dim; ++d)
         f[d] = _mm512_reduce_add_pd(acc[d]);
     }
 #endif
   } // namespace
+
+  namespace
+  {
+    /** One row by the AVX-512 kernel where available, else the portable one. */
+    template <int dim, bool Scatter>
+    inline void
+    pmb_row_dispatch(const double       *p,
+                     const double       *pi,
+                     const std::int32_t *col,
+                     const double       *k,
+                     const double       *r,
+                     std::uint8_t       *broken,
+                     const unsigned int  n,
+                     const double        s0,
+                     double             *f,
+                     const Reaction     &reaction)
+    {
+#ifdef PERIDEAL_PMB_AVX512
+      if constexpr (dim > 1)
+        pmb_row_avx512<dim, Scatter>(p, pi, col, k, r, broken, n, s0, f, reaction);
+      else
+#endif
+        pmb_row<dim, Scatter>(p, pi, col, k, r, broken, n, s0, f, reaction);
+    }
+  } // namespace
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::full_list_forces(VectorField &force)
+  {
+    const auto    &nb = disc.neighborhood;
+    const double  *p  = deformed.data();
+    constexpr auto R  = node_stride<dim>;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint64_t begin  = nb.row_start[i];
+        double              f[dim] = {};
+        pmb_row_dispatch<dim, false>(p, p + std::size_t(R) * i, nb.col.data() + begin,
+                                     bond_coefficient.data() + nb.table_start[i],
+                                     nb.bond_length.data() + nb.table_start[i],
+                                     broken_flag.data() + begin, nb.row_start[i + 1] - begin, s0,
+                                     f, Reaction());
+        for (unsigned int d = 0; d < dim; ++d)
+          force[d].local_element(i) = f[d];
+      }
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::half_list_forces(VectorField &force)
+  {
+    const auto        &nb      = disc.neighborhood;
+    const double      *p       = deformed.data();
+    const unsigned int n_owned = disc.n_owned();
+    constexpr auto     R       = node_stride<dim>;
+    // Force records of all local nodes, interleaved with the positions: the
+    // reactions to ghost nodes land in the ghost records and are dropped
+    // (the ghost's owner evaluates the bond itself, from its ghost list).
+    double *F = deformed.data() + record_size<dim>;
+    newly_broken.clear();
+    Reaction reaction;
+    reaction.force        = F;
+    reaction.n_owned      = n_owned;
+    reaction.newly_broken = &newly_broken;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      {
+        const std::uint64_t h = nb.row_start[i] + half_offset[i];
+        const std::uint64_t t = nb.table_start[i] + half_offset[i];
+        reaction.first_bond   = h;
+        double f[dim]         = {};
+        pmb_row_dispatch<dim, true>(p, p + std::size_t(R) * i, nb.col.data() + h,
+                                    bond_coefficient.data() + t, nb.bond_length.data() + t,
+                                    broken_flag.data() + h, nb.row_start[i + 1] - h, s0, f,
+                                    reaction);
+        for (unsigned int d = 0; d < dim; ++d)
+          F[R * i + d] += f[d];
+      }
+    // Negative-offset bonds to ghosts, from the owned end only.
+    for (std::size_t e = 0; e < ghost_bond.size(); ++e)
+      ghost_broken[e] = broken_flag[ghost_bond[e]];
+    for (std::size_t g = 0; g < ghost_row.size(); ++g)
+      {
+        const unsigned int  i = ghost_row[g];
+        const std::uint64_t e = ghost_row_start[g];
+        double              f[dim] = {};
+        pmb_row_dispatch<dim, false>(p, p + std::size_t(R) * i, ghost_col.data() + e,
+                                     ghost_stiffness.data() + e, ghost_length.data() + e,
+                                     ghost_broken.data() + e, ghost_row_start[g + 1] - e, s0, f,
+                                     Reaction());
+        for (unsigned int d = 0; d < dim; ++d)
+          F[R * i + d] += f[d];
+      }
+    for (std::size_t e = 0; e < ghost_bond.size(); ++e)
+      broken_flag[ghost_bond[e]] = ghost_broken[e];
+    // A bond between owned nodes broke in its half row: flag its other copy.
+    for (const std::uint64_t b : newly_broken)
+      {
+        const auto row = std::upper_bound(nb.row_start.begin(), nb.row_start.end(), b) -
+                         nb.row_start.begin() - 1;
+        broken_flag[mirror_bond(row, b)] = 1;
+      }
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double *fd = force[d].begin();
+        for (unsigned int i = 0; i < n_owned; ++i)
+          fd[i] = F[R * i + d];
+      }
+  }
 
   template <int dim>
   void
@@ -355,8 +684,8 @@ namespace PeriDEAL
         // body, which bounds the round-off of y = p_j - p_i by
         // eps |x - x_c|.
         const std::size_t  n_local = x.size();
-        constexpr unsigned int R   = record_size<dim>;
-        deformed.resize(n_local * R);
+        constexpr unsigned int R   = node_stride<dim>;
+        deformed.assign(n_local * R, 0.);
         std::array<int, dim> mid;
         for (unsigned int d = 0; d < dim; ++d)
           mid[d] = int(disc.lattice_size()[d] / 2);
@@ -367,27 +696,10 @@ namespace PeriDEAL
             for (std::size_t i = 0; i < n_local; ++i)
               deformed[R * i + d] = (x[i][d] - xc[d]) + ud[i];
           }
-        const double *p = deformed.data();
-        for (unsigned int i = 0; i < n_owned; ++i)
-          {
-            const std::uint64_t begin = nb.row_start[i];
-            const unsigned int  n     = nb.row_start[i + 1] - begin;
-            double              f[dim] = {};
-#ifdef PERIDEAL_PMB_AVX512
-            if constexpr (dim > 1)
-              pmb_row_avx512<dim>(p, p + std::size_t(record_size<dim>) * i, nb.col.data() + begin,
-                                  bond_coefficient.data() + nb.table_start[i],
-                                  nb.bond_length.data() + nb.table_start[i],
-                                  broken_flag.data() + begin, n, s0, f);
-            else
-#endif
-              pmb_row<dim>(p, p + std::size_t(record_size<dim>) * i, nb.col.data() + begin,
-                           bond_coefficient.data() + nb.table_start[i],
-                           nb.bond_length.data() + nb.table_start[i], broken_flag.data() + begin,
-                           n, s0, f);
-            for (unsigned int d = 0; d < dim; ++d)
-              force[d].local_element(i) = f[d];
-          }
+        if (half_list)
+          half_list_forces(force);
+        else
+          full_list_forces(force);
         return;
       }
 

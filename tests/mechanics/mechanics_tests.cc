@@ -506,12 +506,13 @@ namespace
   // ulp), so each term is off by ~1e-14 of its unit-stretch value.
   template <int dim>
   void
-  force_kernel_dim()
+  force_kernel_dim(const bool half_list = false)
   {
     const auto               disc = make_box<dim>(MPI_COMM_WORLD, dim == 3 ? 1. : 2., 0.1, 0.3015);
     BondBasedModelParameters p;
     p.critical_stretch = 0.01;
     BondBasedOperator<dim> op(*disc, p);
+    op.set_half_list(half_list);
     typename BondBasedOperator<dim>::VectorField u, f;
     op.initialize(u);
     op.initialize(f);
@@ -566,7 +567,7 @@ namespace
     n_broken   = Utilities::MPI::sum(n_broken, MPI_COMM_WORLD);
     mismatched = Utilities::MPI::sum(mismatched, MPI_COMM_WORLD);
     asymmetric = Utilities::MPI::sum(asymmetric, MPI_COMM_WORLD);
-    const std::string tag = std::to_string(dim) + "D: ";
+    const std::string tag = std::to_string(dim) + (half_list ? "D half list: " : "D: ");
     check(n_broken > 0 && n_broken < nb.n_bonds() * Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD),
           tag + std::to_string(n_broken) + " bond copies broke");
     check(mismatched == 0, tag + std::to_string(mismatched) + " breaking decisions differ from s > s0");
@@ -579,6 +580,105 @@ namespace
   {
     force_kernel_dim<2>();
     force_kernel_dim<3>();
+  }
+
+  // The half-list force loop (each bond between owned nodes evaluated once,
+  // its reaction subtracted from the neighbour; bonds to ghosts evaluated
+  // from the owned end) against the full list, for random displacements
+  // with pre-broken bonds and two calls (bonds break in the first, more in
+  // the second, and the broken ones are skipped): the same forces to
+  // round-off, bitwise the same broken flags (both copies of a bond), the
+  // same damage. Newton's third law: sum_i F_i V_i vanishes to round-off
+  // (the half list adds the two reactions of a bond exactly opposite).
+  // Both loops are also compared with the direct evaluation of (3.1) in
+  // force_kernel_dim().
+  template <int dim>
+  void
+  half_list_dim()
+  {
+    force_kernel_dim<dim>(true);
+    const auto               disc = make_box<dim>(MPI_COMM_WORLD, dim == 3 ? 1. : 2., 0.1, 0.3015);
+    BondBasedModelParameters p;
+    p.critical_stretch = 0.01;
+    BondBasedOperator<dim> half(*disc, p), full(*disc, p);
+    half.set_half_list(true);
+    // Pre-crack-like random cuts: a symmetric predicate of the end points.
+    const auto cuts = [](const Point<dim> &a, const Point<dim> &b) {
+      double h = 0.;
+      for (unsigned int d = 0; d < dim; ++d)
+        h += 12.9898 * (a[d] + b[d]) + 78.233 * a[d] * b[d];
+      return std::abs(std::sin(h) * 43758.5453 - std::floor(std::sin(h) * 43758.5453)) < 0.05;
+    };
+    half.break_bonds(cuts);
+    full.break_bonds(cuts);
+    const std::string tag  = std::to_string(dim) + "D: ";
+    const auto        &nb  = disc->neighborhood;
+    const MPI_Comm     comm = MPI_COMM_WORLD;
+    const std::uint64_t pre = half.n_broken_bonds();
+    check(pre > 0 && pre == full.n_broken_bonds(), tag + std::to_string(pre) + " pre-broken copies");
+
+    typename BondBasedOperator<dim>::VectorField u, fh, ff;
+    half.initialize(u);
+    half.initialize(fh);
+    half.initialize(ff);
+    std::uint64_t broken_before = pre;
+    for (unsigned int call = 0; call < 2; ++call)
+      {
+        for (unsigned int i = 0; i < disc->n_owned(); ++i)
+          for (unsigned int d = 0; d < dim; ++d)
+            u[d].local_element(i) = (0.0015 + 0.001 * call) * hash_random(disc->id[i], d + 7 * call);
+        for (auto &v : u)
+          v.update_ghost_values();
+        half.compute_forces(u, fh);
+        full.compute_forces(u, ff);
+        double err = 0., scale = 0., total[dim] = {}, fabs_sum = 0.;
+        for (unsigned int i = 0; i < disc->n_owned(); ++i)
+          {
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                err = std::max(err, std::abs(fh[d].local_element(i) - ff[d].local_element(i)));
+                total[d] += fh[d].local_element(i) * disc->volume[i];
+                fabs_sum += std::abs(fh[d].local_element(i)) * disc->volume[i];
+              }
+            scale = std::max(scale, half.stiffness_row_sum(i) * disc->parameters().delta);
+          }
+        err      = Utilities::MPI::max(err, comm) / Utilities::MPI::max(scale, comm);
+        fabs_sum = Utilities::MPI::sum(fabs_sum, comm);
+        double momentum = 0.;
+        for (unsigned int d = 0; d < dim; ++d)
+          momentum = std::max(momentum, std::abs(Utilities::MPI::sum(total[d], comm)));
+        unsigned int differ = 0;
+        for (std::uint64_t b = 0; b < nb.n_bonds(); ++b)
+          differ += half.broken()[b] != full.broken()[b];
+        differ = Utilities::MPI::sum(differ, comm);
+        PeriDEAL::Vector phi_h, phi_f;
+        disc->initialize_vector(phi_h);
+        disc->initialize_vector(phi_f);
+        half.damage(phi_h);
+        full.damage(phi_f);
+        double damage_diff = 0.;
+        for (unsigned int i = 0; i < disc->n_owned(); ++i)
+          damage_diff = std::max(damage_diff, std::abs(phi_h.local_element(i) - phi_f.local_element(i)));
+        damage_diff = Utilities::MPI::max(damage_diff, comm);
+        const std::uint64_t broken = half.n_broken_bonds();
+        const std::string   t      = tag + "call " + std::to_string(call + 1) + ": ";
+        check(broken > broken_before && broken < disc->n_global_bonds(),
+              t + std::to_string(broken - broken_before) + " bond copies broke");
+        check(differ == 0, t + std::to_string(differ) + " broken flags differ from the full list");
+        check(damage_diff == 0., t + "max damage difference " + sci(damage_diff));
+        // Round-off: each force is a sum of ~100 terms of size <= scale s0.
+        check(err < 1e-12, t + "max |F_half - F_full| / force scale = " + sci(err));
+        // sum F V over ~1e3 nodes: round-off relative to sum |F| V.
+        check(momentum < 1e-13 * fabs_sum, t + "|sum F V| / sum |F| V = " + sci(momentum / fabs_sum));
+        broken_before = broken;
+      }
+  }
+
+  void
+  half_list()
+  {
+    half_list_dim<2>();
+    half_list_dim<3>();
   }
 } // namespace
 
@@ -593,5 +693,6 @@ main(int argc, char **argv)
               {"momentum", momentum},
               {"fracture", fracture},
               {"rank_invariance", rank_invariance},
-              {"force_kernel", force_kernel}});
+              {"force_kernel", force_kernel},
+              {"half_list", half_list}});
 }
