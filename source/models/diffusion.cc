@@ -230,22 +230,43 @@ namespace PeriDEAL
       }
 
     AssertThrow(phase != nullptr, ExcMessage("The corrosion model needs the phase field."));
-    const double *const ph = phase->begin();
+    const double *const ph           = phase->begin();
+    auto                standard_row = [&](const unsigned int i) {
+      const std::int32_t *ci    = col + row_start[i];
+      const double       *wi    = gw + table[i];
+      const unsigned int  m     = row_start[i + 1] - row_start[i];
+      const double       *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
+      const double        c_i   = c[i];
+      double              s     = 0.;
+      for (unsigned int k = 0; k < m; ++k)
+        {
+          const std::int32_t j = ci[k];
+          s += wi[k] * kappa[ph[j] > 0.5] * (c[j] - c_i);
+        }
+      return s;
+    };
+    const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
     for (unsigned int i = 0; i < n; ++i)
-      {
-        const std::int32_t *ci    = col + row_start[i];
-        const double       *wi    = gw + table[i];
-        const unsigned int  m     = row_start[i + 1] - row_start[i];
-        const double       *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
-        const double        c_i   = c[i];
-        double              s     = 0.;
-        for (unsigned int k = 0; k < m; ++k)
-          {
-            const std::int32_t j = ci[k];
-            s += wi[k] * kappa[ph[j] > 0.5] * (c[j] - c_i);
-          }
-        r[i] = s;
-      }
+      if (skip == nullptr || !skip[i])
+        r[i] = standard_row(i);
+    if (wls)
+      // Omega_w: a WLS row is one phase's operator, valid while all its
+      // collocation nodes share the phase of x_i (kappa of that phase's
+      // bonds, the weights carry no kappa); once the interface reaches them
+      // the row falls back to the standard scheme.
+      for (unsigned int k = 0; k < wls->node.size(); ++k)
+        {
+          const unsigned int i     = wls->node[k];
+          const bool         solid = ph[i] > 0.5;
+          const auto         b = wls->row_start[k], e = wls->row_start[k + 1];
+          bool               same = true;
+          for (auto t = b; t < e && same; ++t)
+            same = (ph[wls->col[t]] > 0.5) == solid;
+          r[i] = same ? bond_kappa(solid, solid) *
+                          weighted_row_sum_short(wls->col.data() + b, wls->weight.data() + b,
+                                                 e - b, c) :
+                        standard_row(i);
+        }
   }
 
   template <int dim>
@@ -263,7 +284,9 @@ namespace PeriDEAL
     const auto  &nb        = disc.neighborhood;
     double       max_sum   = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      if (disc.region[i] == Discretization<dim>::interior && (is_wls.empty() || !is_wls[i]))
+      // (corrosion: WLS rows may fall back to the standard row, so both count)
+      if (disc.region[i] == Discretization<dim>::interior &&
+          (is_wls.empty() || !is_wls[i] || corrosion))
         {
           const double *w      = geometric_weight.data() + nb.table_start[i];
           double        radius = 0.;
@@ -275,7 +298,7 @@ namespace PeriDEAL
     // WLS rows: the same bound with the actual weights (some negative).
     if (wls)
       for (unsigned int k = 0; k < wls->node.size(); ++k)
-        max_sum = std::max(max_sum, 0.5 * wls_gershgorin(k).first);
+        max_sum = std::max(max_sum, 0.5 * (corrosion ? kappa_max : 1.) * wls_gershgorin(k).first);
     max_sum = Utilities::MPI::max(max_sum, disc.get_mpi_communicator());
     return max_sum > 0. ? 1. / max_sum : std::numeric_limits<double>::infinity();
   }
@@ -285,8 +308,6 @@ namespace PeriDEAL
   DiffusionOperator<dim>::set_wls_rows(const WlsParameters             &parameters,
                                        const std::vector<unsigned int> &rows)
   {
-    check_parameter(!corrosion, "Hybrid/Quadrature", "wls or hybrid",
-                    "standard for the corrosion model (bond kappa depends on the phases)");
     is_wls.assign(disc.n_owned(), 0);
     for (const unsigned int i : rows)
       {
@@ -294,6 +315,7 @@ namespace PeriDEAL
                     ExcMessage("WLS rows must be owned interior nodes."));
         is_wls[i] = 1;
       }
+    // Diffusion: the kernel carries kappa; corrosion: constant 1, kappa per row.
     wls = std::make_unique<WlsQuadrature<dim>>(parameters, scalar_kernel);
     // Not build(disc, rows): an empty list would mean "all interior nodes".
     wls->build(disc.position, disc.neighborhood.row_start, disc.neighborhood.col, rows);

@@ -76,8 +76,9 @@ namespace PeriDEAL
                       "collocation quadrature (Sect. 3.2) on every interior node. hybrid: "
                       "the fixed hybrid configuration of Sect. 3.3, standard scheme on "
                       "Omega_s (see 'Standard region width' and 'Standard region'), WLS "
-                      "elsewhere. Non-standard choices need linear diffusion and forward "
-                      "Euler.");
+                      "elsewhere. Non-standard choices need forward Euler; with corrosion a "
+                      "WLS row falls back to the standard one where its collocation nodes "
+                      "are of mixed phase.");
     prm.declare_entry("Standard region width", "0", Patterns::Double(),
                       "hybrid: interior nodes closer than this (>= 0) to the boundary of "
                       "the body (signed distance of the geometry) use the standard "
@@ -165,8 +166,6 @@ namespace PeriDEAL
                     "a non-negative number");
     check_parameter(quadrature == "standard" || scheme == "forward Euler", "Hybrid/Quadrature",
                     quadrature, "standard with backward Euler (the WLS rows are explicit only)");
-    check_parameter(quadrature == "standard" || model.type == "diffusion", "Hybrid/Quadrature",
-                    quadrature, "standard for the corrosion model");
 
     p.enter_subsection("Output");
     output_directory     = p.get("Directory");

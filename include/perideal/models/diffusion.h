@@ -190,9 +190,11 @@ namespace PeriDEAL
      * owned interior nodes @p rows (Omega_w) use the meshfree WLS collocation
      * weights (WlsQuadrature, built here for the kernel with its kappa); all
      * other rows keep the standard scheme (Omega_s). apply() and
-     * critical_time_step() then use the WLS row for these nodes. Linear
-     * diffusion with forward Euler only: throws ParameterError for the
-     * corrosion model (its bond kappa depends on the phases of each bond).
+     * critical_time_step() then use the WLS row for these nodes (forward
+     * Euler only). Corrosion: a WLS row is used with the kappa of its node's
+     * phase while all its collocation nodes share that phase, and falls back
+     * to the standard row once the interface reaches them (Omega_s should
+     * cover the interface's path, as in E4 of the dissertation).
      */
     void
     set_wls_rows(const WlsParameters &parameters, const std::vector<unsigned int> &rows);

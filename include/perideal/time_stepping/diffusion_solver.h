@@ -55,7 +55,7 @@ namespace PeriDEAL
      * 3.3): "standard" everywhere, "wls" (WLS collocation on every interior
      * node) or "hybrid" (fixed Omega_s = interior nodes within
      * standard_width of the boundary or where standard_region > 0, WLS
-     * elsewhere). Linear diffusion with forward Euler only.
+     * elsewhere). Forward Euler only.
      */
     std::string   quadrature      = "standard";
     WlsParameters wls;
