@@ -207,8 +207,11 @@ namespace PeriDEAL
     if (!corrosion)
       {
         const double kappa = kappa_table[0];
+        const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
         for (unsigned int i = 0; i < n; ++i)
           {
+            if (skip != nullptr && skip[i]) // Omega_w: written by the WLS rows below
+              continue;
             const std::int32_t *ci = col + row_start[i];
             const double       *wi = gw + table[i];
             const unsigned int  m  = row_start[i + 1] - row_start[i];
@@ -216,26 +219,54 @@ namespace PeriDEAL
                                                 weighted_row_sum_long(ci, wi, m, c);
             r[i] = kappa * (s - row_sum[i] * c[i]);
           }
+        if (wls) // Omega_w: the WLS rows (weights carry kappa), same short-row kernel
+          for (unsigned int k = 0; k < wls->node.size(); ++k)
+            {
+              const auto b = wls->row_start[k];
+              r[wls->node[k]] = weighted_row_sum_short(wls->col.data() + b, wls->weight.data() + b,
+                                                       wls->row_start[k + 1] - b, c);
+            }
         return;
       }
 
     AssertThrow(phase != nullptr, ExcMessage("The corrosion model needs the phase field."));
-    const double *const ph = phase->begin();
+    const double *const ph           = phase->begin();
+    auto                standard_row = [&](const unsigned int i) {
+      const std::int32_t *ci    = col + row_start[i];
+      const double       *wi    = gw + table[i];
+      const unsigned int  m     = row_start[i + 1] - row_start[i];
+      const double       *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
+      const double        c_i   = c[i];
+      double              s     = 0.;
+      for (unsigned int k = 0; k < m; ++k)
+        {
+          const std::int32_t j = ci[k];
+          s += wi[k] * kappa[ph[j] > 0.5] * (c[j] - c_i);
+        }
+      return s;
+    };
+    const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
     for (unsigned int i = 0; i < n; ++i)
-      {
-        const std::int32_t *ci    = col + row_start[i];
-        const double       *wi    = gw + table[i];
-        const unsigned int  m     = row_start[i + 1] - row_start[i];
-        const double       *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
-        const double        c_i   = c[i];
-        double              s     = 0.;
-        for (unsigned int k = 0; k < m; ++k)
-          {
-            const std::int32_t j = ci[k];
-            s += wi[k] * kappa[ph[j] > 0.5] * (c[j] - c_i);
-          }
-        r[i] = s;
-      }
+      if (skip == nullptr || !skip[i])
+        r[i] = standard_row(i);
+    if (wls)
+      // Omega_w: a WLS row is one phase's operator, valid while all its
+      // collocation nodes share the phase of x_i (kappa of that phase's
+      // bonds, the weights carry no kappa); once the interface reaches them
+      // the row falls back to the standard scheme.
+      for (unsigned int k = 0; k < wls->node.size(); ++k)
+        {
+          const unsigned int i     = wls->node[k];
+          const bool         solid = ph[i] > 0.5;
+          const auto         b = wls->row_start[k], e = wls->row_start[k + 1];
+          bool               same = true;
+          for (auto t = b; t < e && same; ++t)
+            same = (ph[wls->col[t]] > 0.5) == solid;
+          r[i] = same ? bond_kappa(solid, solid) *
+                          weighted_row_sum_short(wls->col.data() + b, wls->weight.data() + b,
+                                                 e - b, c) :
+                        standard_row(i);
+        }
   }
 
   template <int dim>
@@ -253,7 +284,9 @@ namespace PeriDEAL
     const auto  &nb        = disc.neighborhood;
     double       max_sum   = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      if (disc.region[i] == Discretization<dim>::interior)
+      // (corrosion: WLS rows may fall back to the standard row, so both count)
+      if (disc.region[i] == Discretization<dim>::interior &&
+          (is_wls.empty() || !is_wls[i] || corrosion))
         {
           const double *w      = geometric_weight.data() + nb.table_start[i];
           double        radius = 0.;
@@ -262,8 +295,58 @@ namespace PeriDEAL
               radius += w[k - nb.row_start[i]];
           max_sum = std::max(max_sum, 0.5 * kappa_max * (row_sum[i] + radius));
         }
+    // WLS rows: the same bound with the actual weights (some negative).
+    if (wls)
+      for (unsigned int k = 0; k < wls->node.size(); ++k)
+        max_sum = std::max(max_sum, 0.5 * (corrosion ? kappa_max : 1.) * wls_gershgorin(k).first);
     max_sum = Utilities::MPI::max(max_sum, disc.get_mpi_communicator());
     return max_sum > 0. ? 1. / max_sum : std::numeric_limits<double>::infinity();
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::set_wls_rows(const WlsParameters             &parameters,
+                                       const std::vector<unsigned int> &rows)
+  {
+    is_wls.assign(disc.n_owned(), 0);
+    for (const unsigned int i : rows)
+      {
+        AssertThrow(i < disc.n_owned() && disc.region[i] == Discretization<dim>::interior,
+                    ExcMessage("WLS rows must be owned interior nodes."));
+        is_wls[i] = 1;
+      }
+    // Diffusion: the kernel carries kappa; corrosion: constant 1, kappa per row.
+    wls = std::make_unique<WlsQuadrature<dim>>(parameters, scalar_kernel);
+    // Not build(disc, rows): an empty list would mean "all interior nodes".
+    wls->build(disc.position, disc.neighborhood.row_start, disc.neighborhood.col, rows);
+  }
+
+  template <int dim>
+  std::pair<double, bool>
+  DiffusionOperator<dim>::wls_gershgorin(const unsigned int k) const
+  {
+    const unsigned int i    = wls->node[k];
+    double             diag = 0., radius = 0.;
+    for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+      {
+        const unsigned int j = wls->col[e];
+        if (j == i)
+          diag += wls->weight[e];
+        else if (disc.region[j] == Discretization<dim>::interior)
+          radius += std::abs(wls->weight[e]);
+      }
+    return {std::abs(diag) + radius, diag <= 0. && radius <= std::abs(diag) * (1. + 1e-12)};
+  }
+
+  template <int dim>
+  bool
+  DiffusionOperator<dim>::gershgorin_proves_stability() const
+  {
+    bool ok = true;
+    if (wls)
+      for (unsigned int k = 0; k < wls->node.size(); ++k)
+        ok = ok && wls_gershgorin(k).second;
+    return !Utilities::MPI::logical_or(!ok, disc.get_mpi_communicator());
   }
 
   template <int dim>

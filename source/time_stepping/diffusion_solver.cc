@@ -70,6 +70,27 @@ namespace PeriDEAL
                       "diagonally dominant), AMG otherwise.");
     prm.leave_subsection();
 
+    prm.enter_subsection("Hybrid");
+    prm.declare_entry("Quadrature", "standard", Patterns::Selection("standard|wls|hybrid"),
+                      "standard: the standard scheme (3.4) on every node. wls: the WLS "
+                      "collocation quadrature (Sect. 3.2) on every interior node. hybrid: "
+                      "the fixed hybrid configuration of Sect. 3.3, standard scheme on "
+                      "Omega_s (see 'Standard region width' and 'Standard region'), WLS "
+                      "elsewhere. Non-standard choices need forward Euler; with corrosion a "
+                      "WLS row falls back to the standard one where its collocation nodes "
+                      "are of mixed phase.");
+    prm.declare_entry("Standard region width", "0", Patterns::Double(),
+                      "hybrid: interior nodes closer than this (>= 0) to the boundary of "
+                      "the body (signed distance of the geometry) use the standard "
+                      "scheme.");
+    prm.declare_entry("Standard region", "0", Patterns::Anything(),
+                      "hybrid: expression in x, y, z; interior nodes where it is > 0 also "
+                      "use the standard scheme (e.g. '(abs(x) < 0.2) * (abs(y) < 0.2)').");
+    prm.enter_subsection("WLS");
+    WlsParameters::declare_parameters(prm);
+    prm.leave_subsection();
+    prm.leave_subsection();
+
     prm.enter_subsection("Output");
     prm.declare_entry("Directory", "output", Patterns::Anything(),
                       "Where VTU/PVD snapshots, the CSV time series, checkpoints and "
@@ -132,6 +153,19 @@ namespace PeriDEAL
                     "Time stepping/Linear solver tolerance", linear_tolerance, "(0, 1)");
     check_parameter(newton_tolerance > 0. && newton_tolerance < 1.,
                     "Time stepping/Newton tolerance", newton_tolerance, "(0, 1)");
+
+    p.enter_subsection("Hybrid");
+    quadrature      = p.get("Quadrature");
+    standard_width  = p.get_double("Standard region width");
+    standard_region = p.get("Standard region");
+    p.enter_subsection("WLS");
+    wls.parse_parameters(p);
+    p.leave_subsection();
+    p.leave_subsection();
+    check_parameter(standard_width >= 0., "Hybrid/Standard region width", standard_width,
+                    "a non-negative number");
+    check_parameter(quadrature == "standard" || scheme == "forward Euler", "Hybrid/Quadrature",
+                    quadrature, "standard with backward Euler (the WLS rows are explicit only)");
 
     p.enter_subsection("Output");
     output_directory     = p.get("Directory");
@@ -214,6 +248,7 @@ namespace PeriDEAL
     TimerOutput::Scope scope(computing_timer, "setup");
     disc.setup(*prm.domain, prm.lattice);
     op = std::make_unique<DiffusionOperator<dim>>(disc, prm.model);
+    setup_quadrature();
 
     FunctionParser<dim> initial;
     init_function(initial, prm.initial_condition, prm.constants, "Model/Initial condition");
@@ -254,6 +289,7 @@ namespace PeriDEAL
                     "homogeneous nonlocal Neumann ends")
               << ", i.e. 1/max_i sum_j kappa_ij w_ij in the bulk, (16) of paper 003"
               << (op->is_corrosion() ? ", with the largest micro-diffusivity" : "")
+              << (n_wls_global > 0 ? ", WLS rows included" : "")
               << "); use 'backward Euler' for larger steps";
         check_parameter(dt <= dt_critical * (1. + 1e-10), "Time stepping/Time step", dt,
                         bound.str());
@@ -265,6 +301,35 @@ namespace PeriDEAL
     current_step = 0;
     matrix_valid = false;
     recorded.clear();
+  }
+
+  template <int dim>
+  void
+  DiffusionSolver<dim>::setup_quadrature()
+  {
+    n_wls_global = 0;
+    if (prm.quadrature == "standard")
+      return;
+    const bool by_width = prm.quadrature == "hybrid" && prm.standard_width > 0.;
+    check_parameter(!by_width || prm.domain->has_signed_distance(),
+                    "Hybrid/Standard region width", prm.standard_width,
+                    "0 for a geometry without a signed distance (use 'Standard region')");
+    FunctionParser<dim> region;
+    init_function(region, prm.standard_region, prm.constants, "Hybrid/Standard region");
+    std::vector<unsigned int> rows;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        if (disc.region[i] != Discretization<dim>::interior)
+          continue;
+        const Point<dim> &x        = disc.position[i];
+        const bool        standard = prm.quadrature == "hybrid" &&
+                              ((by_width && prm.domain->signed_distance(x) > -prm.standard_width) ||
+                               region.value(x) > 0.);
+        if (!standard)
+          rows.push_back(i);
+      }
+    op->set_wls_rows(prm.wls, rows);
+    n_wls_global = Utilities::MPI::sum<types::global_dof_index>(rows.size(), mpi_communicator);
   }
 
   template <int dim>
@@ -522,6 +587,14 @@ namespace PeriDEAL
           << disc.n_global_bonds() << " bonds, kappa = " << op->kernel().constant
           << ", dt = " << dt << " (forward Euler bound " << dt_critical << "), "
           << total_steps << " steps, scheme: " << prm.scheme << std::endl;
+    if (n_wls_global > 0)
+      pcout << "  quadrature: " << prm.quadrature << ", WLS-" << prm.wls.order << " on "
+            << n_wls_global << " nodes (Omega_w), standard scheme on the others"
+            << (op->gershgorin_proves_stability() ?
+                  "" :
+                  "; WLS rows are not diagonally dominant: the step bound is 2/rho "
+                  "(Gershgorin bound of the spectral radius), not a proof")
+            << std::endl;
 
     if (!resumed)
       record_and_output(true);

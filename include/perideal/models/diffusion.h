@@ -7,10 +7,12 @@
 
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
+#include <perideal/discretization/wls_quadrature.h>
 
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -183,6 +185,39 @@ namespace PeriDEAL
     void
     add_constrained_coupling(const Vector &C, Vector &rhs, const Vector *phase = nullptr) const;
 
+    /**
+     * Hybrid configuration (dissertation Sect. 3.3, "hybrid fixed"): the
+     * owned interior nodes @p rows (Omega_w) use the meshfree WLS collocation
+     * weights (WlsQuadrature, built here for the kernel with its kappa); all
+     * other rows keep the standard scheme (Omega_s). apply() and
+     * critical_time_step() then use the WLS row for these nodes (forward
+     * Euler only). Corrosion: a WLS row is used with the kappa of its node's
+     * phase while all its collocation nodes share that phase, and falls back
+     * to the standard row once the interface reaches them (Omega_s should
+     * cover the interface's path, as in E4 of the dissertation).
+     */
+    void
+    set_wls_rows(const WlsParameters &parameters, const std::vector<unsigned int> &rows);
+
+    /** The WLS quadrature of Omega_w, or nullptr for the pure standard scheme. */
+    const WlsQuadrature<dim> *
+    wls_quadrature() const
+    {
+      return wls.get();
+    }
+
+    /**
+     * True if every row is weakly diagonally dominant over the unknowns
+     * (l_ii <= 0 and R_i <= |l_ii|), i.e. if the Gershgorin discs of the
+     * forward Euler matrix lie in the unit disc for dt <= critical_time_step()
+     * and the bound is a proof. Always true for the standard scheme; WLS rows
+     * have negative off-diagonal weights and may violate it, and then
+     * critical_time_step() is only the bound 2/rho with rho the Gershgorin
+     * bound of the spectral radius (collective over the communicator).
+     */
+    bool
+    gershgorin_proves_stability() const;
+
     /** The bond coefficient kappa for end-point phases (0 liquid, 1 solid). */
     double
     bond_kappa(const bool solid_i, const bool solid_j) const
@@ -199,6 +234,13 @@ namespace PeriDEAL
     std::vector<double> geometric_weight;
     /** Row sums of geometric_weight. */
     std::vector<double> row_sum;
+    /** Hybrid: WLS rows (Omega_w) and a per-owned-node flag; empty if none. */
+    std::unique_ptr<WlsQuadrature<dim>> wls;
+    std::vector<unsigned char>          is_wls;
+
+    /** |l_ii| + R_i and l_ii <= 0 && R_i <= |l_ii| of WLS row k. */
+    std::pair<double, bool>
+    wls_gershgorin(const unsigned int k) const;
   };
 } // namespace PeriDEAL
 

@@ -50,6 +50,18 @@ namespace PeriDEAL
     /** "AMG", "Jacobi" or "auto" (Jacobi when dt is within 10x of the explicit bound). */
     std::string preconditioner = "auto";
 
+    /**
+     * Quadrature of the operator (subsection Hybrid, dissertation Sect.
+     * 3.3): "standard" everywhere, "wls" (WLS collocation on every interior
+     * node) or "hybrid" (fixed Omega_s = interior nodes within
+     * standard_width of the boundary or where standard_region > 0, WLS
+     * elsewhere). Forward Euler only.
+     */
+    std::string   quadrature      = "standard";
+    WlsParameters wls;
+    double        standard_width  = 0.;
+    std::string   standard_region = "0"; ///< expression in x, y, z; > 0: Omega_s
+
     std::string  output_directory     = "output";
     unsigned int snapshot_interval    = 0; ///< steps between VTU snapshots (0: first+last)
     unsigned int time_series_interval = 1; ///< steps between CSV rows
@@ -168,6 +180,12 @@ namespace PeriDEAL
     {
       return dt_critical;
     }
+    /** Hybrid: global number of WLS rows (Omega_w); 0 for the standard scheme. */
+    types::global_dof_index
+    n_wls_rows() const
+    {
+      return n_wls_global;
+    }
     /** Newton iterations of the last implicit step. */
     unsigned int
     last_newton_iterations() const
@@ -190,6 +208,8 @@ namespace PeriDEAL
     }
 
   private:
+    void
+    setup_quadrature();
     void
     explicit_step();
     void
@@ -220,6 +240,7 @@ namespace PeriDEAL
     Vector C, rate, phase;
     double dt = 0., dt_critical = 0., current_time = 0.;
     unsigned int current_step = 0, total_steps = 0;
+    types::global_dof_index n_wls_global = 0;
     unsigned int newton_iterations = 0, linear_iterations = 0;
 
     TrilinosWrappers::SparseMatrix     matrix;
