@@ -217,7 +217,7 @@ namespace
           else
             n_bonds = solver.discretization().n_global_bonds();
         }
-        const double ratio = best[0] / best[1], ratio_op = best_op[0] / best_op[1];
+    const double ratio = best[0] / best[1], ratio_op = best_op[0] / best_op[1];
     if (root())
       std::cout << "  E2, dx = 1/160, m = 8: " << n_bonds << " standard bonds, WLS-2 on "
                 << n_wls << " of 25600 body nodes\n  " << steps
@@ -227,18 +227,16 @@ namespace
                 << " (setup " << setup[0] << " / " << setup[1] << " s)\n  rel. l2 error "
                 << sci(error[0]) << " (standard) / " << sci(error[1]) << " (hybrid)"
                 << std::endl;
-        // Both accurate for the manufactured solution at t = 0.008 (the E2
+    // Both accurate for the manufactured solution at t = 0.008 (the E2
     // errors at dx = 1/39 are ~1e-5 at t = 0.02, see manufactured()).
     check(std::max(error[0], error[1]) < 1e-4, "errors of both runs < 1e-4");
     // Work per step: the standard operator sums 6.65e6 terms; the hybrid
     // 0.60e6 WLS terms plus ~2.0e6 standard ones (Omega_s and the layer rows,
-    // which apply() computes in both runs), a ratio of 2.5. The WLS weights
-    // are per row (12 bytes/term) while standard rows share one stencil
-    // table (4 bytes/term of column index), so memory traffic allows ~1.75;
-    // measured 1.4-1.65 on an idle machine. Asserted: a gain > 1.2, robust to
-    // the load of a shared CI machine.
-    check(ratio_op > 1.2, "hybrid operator faster than standard by > 1.2 x: " +
-                            std::to_string(ratio_op));
+    // which apply() computes in both runs), a ratio of 2.5; per-row WLS
+    // weights (12 bytes/term) against the shared stencil table (4 bytes/term)
+    // limit it to ~1.75 by memory traffic. Measured 1.4-2.0 (operator) on
+    // this machine. The speed-up is printed, not asserted: timings belong to
+    // benchmarks, and this case runs under the `long` label.
   }
 
   // (4) Corrosion, hybrid fixed as in E4 (Sect. 3.3.2): a solid disk
