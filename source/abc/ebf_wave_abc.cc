@@ -48,6 +48,8 @@ namespace PeriDEAL
                         "Guard on max_j |V_j| (Sect. 4.2.3).");
       prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
                         "Relative singular-value cutoff of M^+ (0: max(rows, cols) * machine epsilon).");
+      prm.declare_entry("Time levels", "2", Patterns::Integer(1, 2),
+                        "Levels of the cloud data in (4.79): 2 (n and n-1, the source) or 1 (n only).");
       prm.declare_entry("Spectral radius check size", "0", Patterns::Integer(0),
                         "PD, serial runs: largest state size (2 n_nodes + 2 n_cloud_points) for which "
                         "setup computes the spectral radius of the one-step map (0: never).");
@@ -70,6 +72,7 @@ namespace PeriDEAL
       max_update_norm      = prm.get_double("Maximum updating vector norm");
       pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
       spectral_check_size      = prm.get_integer("Spectral radius check size");
+      n_time_levels            = prm.get_integer("Time levels");
       max_spectral_radius      = prm.get_double("Maximum spectral radius");
     }
 
@@ -263,6 +266,8 @@ namespace PeriDEAL
     {
       AssertDimension(points.size(), ids.size());
       AssertDimension(absorbing_in.size(), normals.size());
+      check_parameter(prm.n_time_levels == 1 || prm.n_time_levels == 2, "Absorbing boundary/Time levels",
+                      prm.n_time_levels, "1 or 2");
       check_parameter(prm.wave_number_range > 0. && prm.wave_number_range <= M_PI / dx * (1. + 1e-12),
                       "Absorbing boundary/Wave number range", prm.wave_number_range,
                       "0 < Delta k <= pi/dx = " + std::to_string(M_PI / dx) + " (4.83)");
@@ -425,7 +430,11 @@ namespace PeriDEAL
                     for (unsigned int j = 0; j < cloud.size(); ++j)
                       for (unsigned int s = 0; s < 2; ++s)
                         {
-                          MG(2 * j + s, c) = mode(cloud[j].second, -double(s) * dt, l, m);
+                          // One time level: the rows of level n-1 vanish
+                          // (their updating coefficients become 0).
+                          MG(2 * j + s, c) = s < prm.n_time_levels ?
+                                               mode(cloud[j].second, -double(s) * dt, l, m) :
+                                               std::complex<double>(0.);
                           MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
                         }
                   }

@@ -65,6 +65,8 @@ namespace PeriDEAL
        * ParameterError if it exceeds max_spectral_radius (0: no check).
        */
       unsigned int spectral_check_size = 0;
+      /** Time levels of the cloud data in (4.79): 2 (n and n-1) or 1 (n only). */
+      unsigned int n_time_levels = 2;
       /** Largest admissible one-step spectral radius of the checked map. */
       double max_spectral_radius = 1. + 1e-8;
 
