@@ -1,5 +1,7 @@
 #include <deal.II/base/quadrature_lib.h>
 
+#include <deal.II/lac/lapack_full_matrix.h>
+
 #include <boost/math/special_functions/bessel.hpp>
 
 #include <perideal/abc/ebf_wave_abc.h>
@@ -46,6 +48,13 @@ namespace PeriDEAL
                         "Guard on max_j |V_j| (Sect. 4.2.3).");
       prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
                         "Relative singular-value cutoff of M^+ (0: max(rows, cols) * machine epsilon).");
+      prm.declare_entry("Time levels", "2", Patterns::Integer(1, 2),
+                        "Levels of the cloud data in (4.79): 2 (n and n-1, the source) or 1 (n only).");
+      prm.declare_entry("Spectral radius check size", "0", Patterns::Integer(0),
+                        "PD, serial runs: largest state size (2 n_nodes + 2 n_cloud_points) for which "
+                        "setup computes the spectral radius of the one-step map (0: never).");
+      prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
+                        "Setup throws ParameterError if the checked spectral radius exceeds this.");
     }
 
     void
@@ -62,6 +71,9 @@ namespace PeriDEAL
       max_condition_number = prm.get_double("Maximum condition number");
       max_update_norm      = prm.get_double("Maximum updating vector norm");
       pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
+      spectral_check_size      = prm.get_integer("Spectral radius check size");
+      n_time_levels            = prm.get_integer("Time levels");
+      max_spectral_radius      = prm.get_double("Maximum spectral radius");
     }
 
 
@@ -254,6 +266,8 @@ namespace PeriDEAL
     {
       AssertDimension(points.size(), ids.size());
       AssertDimension(absorbing_in.size(), normals.size());
+      check_parameter(prm.n_time_levels == 1 || prm.n_time_levels == 2, "Absorbing boundary/Time levels",
+                      prm.n_time_levels, "1 or 2");
       check_parameter(prm.wave_number_range > 0. && prm.wave_number_range <= M_PI / dx * (1. + 1e-12),
                       "Absorbing boundary/Wave number range", prm.wave_number_range,
                       "0 < Delta k <= pi/dx = " + std::to_string(M_PI / dx) + " (4.83)");
@@ -416,7 +430,11 @@ namespace PeriDEAL
                     for (unsigned int j = 0; j < cloud.size(); ++j)
                       for (unsigned int s = 0; s < 2; ++s)
                         {
-                          MG(2 * j + s, c) = mode(cloud[j].second, -double(s) * dt, l, m);
+                          // One time level: the rows of level n-1 vanish
+                          // (their updating coefficients become 0).
+                          MG(2 * j + s, c) = s < prm.n_time_levels ?
+                                               mode(cloud[j].second, -double(s) * dt, l, m) :
+                                               std::complex<double>(0.);
                           MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
                         }
                   }
@@ -546,6 +564,7 @@ namespace PeriDEAL
       dt = model.time_step;
       d  = model.damping;
       t  = 0.;
+      spectral_radius = 0.;
       for (Vector *x : {&u, &v, &a, &Lu})
         disc.initialize_vector(*x);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
@@ -609,6 +628,29 @@ namespace PeriDEAL
       std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
       abc.reinit(disc.position, ids, nodes, normals, *relation, dt, lattice.dx, prm,
                  disc.get_mpi_communicator());
+      // The local guards do not imply stability of the coupled recursion
+      // (doc/design.md): check the global one-step map where affordable.
+      const std::size_t state = 2 * std::size_t(disc.n_owned()) + 2 * abc.cloud_points().size();
+      if (prm.spectral_check_size > 0 && state <= prm.spectral_check_size &&
+          Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) == 1)
+        {
+          unsigned int         n_up = 0;
+          std::complex<double> dominant;
+          spectral_radius = one_step_spectral_radius(prm.spectral_check_size, &n_up, &dominant);
+          if (spectral_radius > prm.max_spectral_radius)
+            {
+              std::ostringstream v;
+              v.precision(10);
+              v << "one-step spectral radius " << spectral_radius << " (" << n_up
+                << " eigenvalues of modulus > 1 + 1e-8, dominant angle " << std::arg(dominant)
+                << " per step) of the near field with the absorbing boundary (" << state
+                << " state entries; every cloud passed cond <= " << prm.max_condition_number
+                << ", max |V| <= " << prm.max_update_norm << ")";
+              throw ParameterError("Absorbing boundary/Maximum spectral radius", v.str(),
+                                   "<= " + std::to_string(prm.max_spectral_radius) +
+                                     " (unstable: change the mode set, cone or layer)");
+            }
+        }
     }
 
     template <int dim>
@@ -656,6 +698,91 @@ namespace PeriDEAL
       const auto end = clock::now();
       abc_seconds += std::chrono::duration<double>(abc_end - start + end - set_start).count();
       step_seconds += std::chrono::duration<double>(end - start).count();
+    }
+
+    template <int dim>
+    double
+    PdUnboundedWave<dim>::one_step_spectral_radius(const unsigned int    max_size,
+                                                   unsigned int         *n_unstable,
+                                                   std::complex<double> *dominant)
+    {
+      const MPI_Comm comm = disc.get_mpi_communicator();
+      check_parameter(Utilities::MPI::n_mpi_processes(comm) == 1, "MPI ranks",
+                      Utilities::MPI::n_mpi_processes(comm),
+                      "1 (the spectral radius check assembles the dense one-step map)");
+      const unsigned int               n = disc.n_owned();
+      const std::vector<unsigned int> &c = abc.cloud_points();
+      const unsigned int               m = 2 * n + (absorbing ? 2 * c.size() : 0);
+      check_parameter(m <= max_size, "State size of the spectral radius check", m,
+                      "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
+      // Save the solver state.
+      const Vector              u0 = u, v0 = v, a0 = a;
+      const std::vector<double> uo0 = u_old, vo0 = v_old;
+      const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      const auto                set_state = [&](const std::vector<double> &x) {
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            u.local_element(i) = x[i];
+            v.local_element(i) = x[n + i];
+          }
+        if (absorbing)
+          for (unsigned int q = 0; q < c.size(); ++q)
+            {
+              u_old[c[q]] = x[2 * n + q];
+              v_old[c[q]] = x[2 * n + c.size() + q];
+            }
+        u.update_ghost_values();
+        v.update_ghost_values();
+        // The acceleration of a consistent state (only read at nodes whose
+        // v is not overwritten by the absorbing update).
+        op->apply(u, Lu);
+        for (unsigned int i = 0; i < n; ++i)
+          a.local_element(i) = Lu.local_element(i) - 2. * d * v.local_element(i);
+      };
+      LAPACKFullMatrix<double> map(m, m);
+      std::vector<double>      x(m);
+      for (unsigned int col = 0; col < m; ++col)
+        {
+          std::fill(x.begin(), x.end(), 0.);
+          x[col] = 1.;
+          set_state(x);
+          advance();
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              map(i, col)     = u.local_element(i);
+              map(n + i, col) = v.local_element(i);
+            }
+          if (absorbing)
+            for (unsigned int q = 0; q < c.size(); ++q)
+              {
+                map(2 * n + q, col)            = u_old[c[q]];
+                map(2 * n + c.size() + q, col) = v_old[c[q]];
+              }
+        }
+      u     = u0;
+      v     = v0;
+      a     = a0;
+      u_old = uo0;
+      v_old = vo0;
+      u.update_ghost_values();
+      v.update_ghost_values();
+      t            = t0;
+      abc_seconds  = abc0;
+      step_seconds = step0;
+      map.compute_eigenvalues(false, false);
+      double       rho = 0.;
+      unsigned int n_up = 0;
+      for (unsigned int i = 0; i < m; ++i)
+        {
+          const double mod = std::abs(map.eigenvalue(i));
+          if (mod > rho && dominant)
+            *dominant = map.eigenvalue(i);
+          rho = std::max(rho, mod);
+          n_up += mod > 1. + 1e-8 ? 1 : 0;
+        }
+      if (n_unstable)
+        *n_unstable = n_up;
+      return rho;
     }
 
     template <int dim>

@@ -58,6 +58,17 @@ namespace PeriDEAL
        * default rank threshold max(rows, cols) * epsilon).
        */
       double pseudo_inverse_tolerance = 0.;
+      /**
+       * PD, serial runs: if the state size 2 n_nodes + 2 n_cloud_points is at
+       * most this, setup computes the spectral radius of the one-step map
+       * (PdUnboundedWave::one_step_spectral_radius) and throws
+       * ParameterError if it exceeds max_spectral_radius (0: no check).
+       */
+      unsigned int spectral_check_size = 0;
+      /** Time levels of the cloud data in (4.79): 2 (n and n-1) or 1 (n only). */
+      unsigned int n_time_levels = 2;
+      /** Largest admissible one-step spectral radius of the checked map. */
+      double max_spectral_radius = 1. + 1e-8;
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -252,6 +263,22 @@ namespace PeriDEAL
       advance();
 
       /**
+       * Spectral radius of the linear one-step map of the whole truncated
+       * system (near-field Verlet plus the absorbing update): the state
+       * (u, v of all nodes, u^{n-1}, v^{n-1} of the cloud points; the
+       * acceleration is L u - 2 d v) is mapped column by column through
+       * advance() and the eigenvalues of the dense matrix are computed by
+       * LAPACK. Serial only and at most @p max_size state entries
+       * (ParameterError otherwise); the solver state is restored. The number
+       * of eigenvalues with modulus > 1 + 1e-8 goes to @p n_unstable and the
+       * eigenvalue of largest modulus to @p dominant if given.
+       */
+      double
+      one_step_spectral_radius(const unsigned int    max_size   = 4000,
+                               unsigned int         *n_unstable = nullptr,
+                               std::complex<double> *dominant   = nullptr);
+
+      /**
        * Wave energy (4.99) of the nodes x_i with @p inside(x_i): 1/2 sum v_i^2 V_i +
        * 1/4 sum_i sum_j k (u_j - u_i)^2 beta V_j V_i (all ranks).
        */
@@ -292,6 +319,8 @@ namespace PeriDEAL
       }
       /** Wall seconds in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
+      /** One-step spectral radius computed by setup (0 if not checked). */
+      double spectral_radius = 0.;
 
     private:
       Discretization<dim>                     disc;
