@@ -5,6 +5,7 @@
 // was compared and makes the test program return non-zero.
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <cmath>
 #include <functional>
@@ -20,6 +21,19 @@ namespace PeriDEALTests
   {
     static int n = 0;
     return n;
+  }
+
+  /** Parameters of type P (declare_parameters / parse_parameters) from text. */
+  template <typename P>
+  P
+  parameters_from_text(const std::string &text)
+  {
+    dealii::ParameterHandler prm;
+    P::declare_parameters(prm);
+    prm.parse_input_from_string(text);
+    P p;
+    p.parse_parameters(prm);
+    return p;
   }
 
   inline bool

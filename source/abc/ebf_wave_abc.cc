@@ -4,6 +4,7 @@
 
 #include <boost/math/special_functions/bessel.hpp>
 
+#include <perideal/abc/absorbing_layer.h>
 #include <perideal/abc/ebf_wave_abc.h>
 #include <perideal/base/exceptions.h>
 
@@ -601,30 +602,9 @@ namespace PeriDEAL
       if (prm.cloud_radius <= 0.)
         prm.cloud_radius = delta;
       const double layer = prm.layer_thickness > 0 ? prm.layer_thickness : delta;
-      check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
-                      prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
-      check_parameter(layer >= lattice.dx * (1. - 1e-12), "Absorbing boundary/Layer thickness",
-                      layer, ">= dx (at least one node layer)");
-      const double                h = 1e-3 * lattice.dx;
       std::vector<unsigned int>   nodes;
       std::vector<Tensor<1, dim>> normals;
-      for (unsigned int i = 0; i < disc.n_owned(); ++i)
-        {
-          const Point<dim> &x = disc.position[i];
-          if (-domain.signed_distance(x) < layer - 1e-8 * lattice.dx)
-            {
-              Tensor<1, dim> n;
-              for (unsigned int dd = 0; dd < dim; ++dd)
-                {
-                  Point<dim> xp = x, xm = x;
-                  xp[dd] += h;
-                  xm[dd] -= h;
-                  n[dd] = domain.signed_distance(xp) - domain.signed_distance(xm);
-                }
-              nodes.push_back(i);
-              normals.push_back(n / n.norm());
-            }
-        }
+      find_absorbing_layer(disc, domain, layer, prm.cloud_radius, nodes, normals);
       std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
       abc.reinit(disc.position, ids, nodes, normals, *relation, dt, lattice.dx, prm,
                  disc.get_mpi_communicator());

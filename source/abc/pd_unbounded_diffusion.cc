@@ -1,5 +1,6 @@
 #include <chrono>
 
+#include <perideal/abc/absorbing_layer.h>
 #include <perideal/abc/pd_unbounded_diffusion.h>
 #include <perideal/base/exceptions.h>
 
@@ -50,37 +51,16 @@ namespace PeriDEAL
       abc = EbfDiffusionAbc<dim>();
       if (boundary == TruncationBoundary::neumann)
         return;
-      const double h = 1e-3 * lattice.dx;
-      // The ghost layer holds every node within delta + dx/2 of an owned node.
-      check_parameter(prm.cloud_radius <= delta + 0.5 * lattice.dx, "Absorbing boundary/Cloud radius",
-                      prm.cloud_radius, "<= delta + dx/2 (clouds must lie within the ghost layer)");
-      check_parameter(layer >= lattice.dx - 1e-12 * lattice.dx, "Absorbing boundary/Layer thickness",
-                      layer, ">= dx (at least one node layer)");
-
-      // Absorbing nodes: the owned nodes closer than delta_L to the
-      // truncation boundary (delta_L / dx node layers); the outward normal
-      // is the gradient of the signed distance.
+      // Absorbing nodes: delta_L / dx node layers inside the truncation
+      // boundary.
       std::vector<unsigned int>   absorbing_nodes;
       std::vector<Tensor<1, dim>> normals;
-      bool                        solid_absorbing = false;
-      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      find_absorbing_layer(disc, domain, layer, prm.cloud_radius, absorbing_nodes, normals);
+      bool solid_absorbing = false;
+      for (const unsigned int i : absorbing_nodes)
         {
-          const Point<dim> &x = disc.position[i];
-          if (-domain.signed_distance(x) < layer - 1e-8 * lattice.dx)
-            {
-              Tensor<1, dim> n;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  Point<dim> xp = x, xm = x;
-                  xp[d] += h;
-                  xm[d] -= h;
-                  n[d] = domain.signed_distance(xp) - domain.signed_distance(xm);
-                }
-              absorbing_nodes.push_back(i);
-              absorbing[i] = true;
-              normals.push_back(n / n.norm());
-              solid_absorbing = solid_absorbing || phase.local_element(i) > 0.5;
-            }
+          absorbing[i]    = true;
+          solid_absorbing = solid_absorbing || phase.local_element(i) > 0.5;
         }
       // The far field is the electrolyte: the modes solve liquid diffusion.
       check_parameter(!Utilities::MPI::logical_or(solid_absorbing, disc.get_mpi_communicator()),

@@ -23,18 +23,6 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  template <int dim>
-  DiffusionRunParameters<dim>
-  parameters_from(const std::string &text)
-  {
-    ParameterHandler prm;
-    DiffusionRunParameters<dim>::declare_parameters(prm);
-    prm.parse_input_from_string(text);
-    DiffusionRunParameters<dim> p;
-    p.parse_parameters(prm);
-    return p;
-  }
-
   // Table 4.1 and (2.43): the constants computed by quadrature of the kernel
   // definition equal the printed closed forms. Tolerance 1e-10: the
   // quadrature is exact up to round-off for integer exponents.
@@ -258,7 +246,7 @@ namespace
     const std::string common = "subsection Discretization\n set Grid spacing = 0.05\n"
                                " set Horizon factor = 3\n set Volume constraint layer = -1\nend\n";
     auto count = [&](const std::string &geometry) {
-      auto              p = parameters_from<2>("subsection Geometry\n" + geometry + "end\n" + common);
+      auto              p = parameters_from_text<DiffusionRunParameters<2>>("subsection Geometry\n" + geometry + "end\n" + common);
       Discretization<2> d(MPI_COMM_WORLD);
       d.setup(*p.domain, p.lattice);
       unsigned int layer = 0;
@@ -323,35 +311,35 @@ end
   void
   bad_input()
   {
-    expect_error([] { parameters_from<2>(base_2d + "subsection Discretization\n set Horizon = 0.05\nend\n"); },
+    expect_error([] { parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Discretization\n set Horizon = 0.05\nend\n"); },
                  "Horizon", "horizon smaller than the spacing");
-    expect_error([] { parameters_from<2>(base_2d + "subsection Discretization\n set Grid spacing = -1\nend\n"); },
+    expect_error([] { parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Discretization\n set Grid spacing = -1\nend\n"); },
                  "Grid spacing", "negative spacing");
     expect_error([] { parse_influence_function("cubic", "Model/Influence function"); },
                  "Influence function", "unknown influence function");
     expect_error([] {
-                   auto p = parameters_from<2>(base_2d + "subsection Geometry\n set Domain = level set\n set Level set = 1\nend\n");
+                   auto p = parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Geometry\n set Domain = level set\n set Level set = 1\nend\n");
                    DiffusionSolver<2> s(MPI_COMM_WORLD, p);
                    s.setup();
                  },
                  "Domain", "empty body");
-    expect_error([] { parameters_from<2>(base_2d + "subsection Geometry\n set Domain = mesh\n set Mesh file = /nonexistent/file.msh\nend\n"); },
+    expect_error([] { parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Geometry\n set Domain = mesh\n set Mesh file = /nonexistent/file.msh\nend\n"); },
                  "Mesh file", "unreadable mesh");
     {
       std::ofstream("malformed.msh") << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0\n";
-      expect_error([] { parameters_from<2>(base_2d + "subsection Geometry\n set Domain = mesh\n set Mesh file = malformed.msh\nend\n"); },
+      expect_error([] { parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Geometry\n set Domain = mesh\n set Mesh file = malformed.msh\nend\n"); },
                    "Mesh file", "malformed mesh");
     }
     expect_error([] {
-                   auto p = parameters_from<2>(base_2d + "subsection Time stepping\n set Time step = 1\nend\n");
+                   auto p = parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Time stepping\n set Time step = 1\nend\n");
                    DiffusionSolver<2> s(MPI_COMM_WORLD, p);
                    s.setup();
                  },
                  "Time step", "time step above the stability bound");
-    expect_error([] { parameters_from<2>(base_2d + "subsection Model\n set Kernel exponent = 5\nend\n"); },
+    expect_error([] { parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Model\n set Kernel exponent = 5\nend\n"); },
                  "Kernel exponent", "kernel without second moment");
     expect_error([] {
-                   auto p = parameters_from<2>(base_2d + "subsection Model\n set Initial condition = sin(\nend\n");
+                   auto p = parameters_from_text<DiffusionRunParameters<2>>(base_2d + "subsection Model\n set Initial condition = sin(\nend\n");
                    DiffusionSolver<2> s(MPI_COMM_WORLD, p);
                    s.setup();
                  },
@@ -380,7 +368,7 @@ subsection Model
   set Initial condition = (x > 4.95) * (x < 5.05)
 end
 )";
-    auto p = parameters_from<1>(text);
+    auto p = parameters_from_text<DiffusionRunParameters<1>>(text);
     // m = 1 without partial volume: w = kappa/dx * dx on both sides, the
     // Gershgorin bound 1/(2 kappa) equals the von Neumann limit 2/lambda_max.
     DiffusionSolver<1> probe(MPI_COMM_WORLD, p);
@@ -454,7 +442,7 @@ subsection Time stepping
   set Newton tolerance = 1e-14
 end
 )";
-    auto p = parameters_from<dim>(text);
+    auto p = parameters_from_text<DiffusionRunParameters<dim>>(text);
     p.output_directory = "mass_output";
     DiffusionSolver<dim> s(MPI_COMM_WORLD, p);
     s.setup();
@@ -523,7 +511,7 @@ subsection Time stepping
   set Newton tolerance = 1e-13
 end
 )";
-    auto p = parameters_from<dim>(text);
+    auto p = parameters_from_text<DiffusionRunParameters<dim>>(text);
 
     std::map<types::particle_index, double> world_values;
     {

@@ -21,18 +21,6 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  template <int dim>
-  DiffusionRunParameters<dim>
-  parameters_from(const std::string &text)
-  {
-    ParameterHandler prm;
-    DiffusionRunParameters<dim>::declare_parameters(prm);
-    prm.parse_input_from_string(text);
-    DiffusionRunParameters<dim> p;
-    p.parse_parameters(prm);
-    return p;
-  }
-
   // E2 of the dissertation (Sect. 3.2.6): (3.77) C = sin(5t) P(x, y) on
   // (-0.5, 0.5)^2 with the exact nonlocal source (3.78) of the operator
   // int (C' - C)/|xi|^2 dA (kappa = 1, q = 2, omega_0), Dirichlet data on a
@@ -75,7 +63,7 @@ namespace
   run_e2(const unsigned int n, const double end_time, const std::string &hybrid,
          const MPI_Comm comm = MPI_COMM_WORLD)
   {
-    DiffusionSolver<2> solver(comm, parameters_from<2>(e2_parameters(n, end_time, hybrid)));
+    DiffusionSolver<2> solver(comm, parameters_from_text<DiffusionRunParameters<2>>(e2_parameters(n, end_time, hybrid)));
     solver.setup();
     Timer timer(comm, true);
     while (solver.step() < solver.n_steps())
@@ -142,8 +130,8 @@ namespace
   {
     const std::string hybrid = " set Quadrature = hybrid\n set Standard region width = 0.25\n";
     const std::string text   = e2_parameters(20, 0.002, hybrid);
-    DiffusionSolver<2> dist(MPI_COMM_WORLD, parameters_from<2>(text));
-    DiffusionSolver<2> serial(MPI_COMM_SELF, parameters_from<2>(text));
+    DiffusionSolver<2> dist(MPI_COMM_WORLD, parameters_from_text<DiffusionRunParameters<2>>(text));
+    DiffusionSolver<2> serial(MPI_COMM_SELF, parameters_from_text<DiffusionRunParameters<2>>(text));
     for (auto *s : {&dist, &serial})
       {
         s->setup();
@@ -199,7 +187,7 @@ namespace
       for (unsigned int h = 0; h < 2; ++h)
         {
           DiffusionSolver<2> solver(MPI_COMM_WORLD,
-                                    parameters_from<2>(e2_parameters(
+                                    parameters_from_text<DiffusionRunParameters<2>>(e2_parameters(
                                       n, steps * dt, h ? width.str() : "", m, dt)));
           Timer t0(MPI_COMM_WORLD, true);
           solver.setup();
@@ -262,7 +250,7 @@ namespace
         << "subsection Time stepping\n set End time = 8\n set Time step = 0.032\nend\n"
         << "subsection Output\n set Time series interval = 1000000\nend\n"
         << "subsection Hybrid\n" << hybrid << "end\n";
-      return parameters_from<2>(s.str());
+      return parameters_from_text<DiffusionRunParameters<2>>(s.str());
     };
     std::vector<std::vector<double>> loss(2);
     types::global_dof_index          n_wls = 0;
@@ -327,9 +315,9 @@ namespace
       check(ok, "ParameterError naming " + name);
     };
     const std::string base = e2_parameters(10, 0.001, "");
-    expect([&] { parameters_from<2>(base + "subsection Hybrid\n set Quadrature = hybrid\n set Standard region width = -1\nend\n"); },
+    expect([&] { parameters_from_text<DiffusionRunParameters<2>>(base + "subsection Hybrid\n set Quadrature = hybrid\n set Standard region width = -1\nend\n"); },
            "Standard region width");
-    expect([&] { parameters_from<2>(base + "subsection Hybrid\n set Quadrature = wls\nend\nsubsection Time stepping\n set Scheme = backward Euler\nend\n"); },
+    expect([&] { parameters_from_text<DiffusionRunParameters<2>>(base + "subsection Hybrid\n set Quadrature = wls\nend\nsubsection Time stepping\n set Scheme = backward Euler\nend\n"); },
            "Quadrature");
   }
 } // namespace

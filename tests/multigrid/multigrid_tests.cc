@@ -287,11 +287,7 @@ namespace
   DiffusionRunParameters<dim>
   uniform_parameters(const std::string &text)
   {
-    ParameterHandler prm;
-    DiffusionRunParameters<dim>::declare_parameters(prm);
-    prm.parse_input_from_string(text);
-    DiffusionRunParameters<dim> p;
-    p.parse_parameters(prm);
+    auto p             = parameters_from_text<DiffusionRunParameters<dim>>(text);
     p.output_directory = "uniform_output";
     return p;
   }

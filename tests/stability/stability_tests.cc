@@ -227,11 +227,7 @@ subsection Discretization
 )") + (layer ? "  set Volume constraint layer = 0.2\n" : "") +
                                    "end\nsubsection Model\n  set Influence function = " + omega +
                                    "\nend\n";
-          ParameterHandler prm;
-          DiffusionRunParameters<1>::declare_parameters(prm);
-          prm.parse_input_from_string(text);
-          DiffusionRunParameters<1> p;
-          p.parse_parameters(prm);
+          const auto p = parameters_from_text<DiffusionRunParameters<1>>(text);
           DiffusionSolver<1> s(MPI_COMM_WORLD, p);
           s.setup();
           const auto  &disc = s.discretization();
@@ -606,11 +602,7 @@ subsection Time stepping
   set End time = 0.5
 end
 )";
-        ParameterHandler prm;
-        DiffusionRunParameters<1>::declare_parameters(prm);
-        prm.parse_input_from_string(text);
-        DiffusionRunParameters<1> p;
-        p.parse_parameters(prm);
+        const auto p = parameters_from_text<DiffusionRunParameters<1>>(text);
         DiffusionSolver<1> s(MPI_COMM_WORLD, p);
         s.setup();
         double t_solid = -1.;
