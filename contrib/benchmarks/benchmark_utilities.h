@@ -8,10 +8,14 @@
 #include <deal.II/base/mpi.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
 #include <ctime>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -88,6 +92,55 @@ namespace PeriDEALBenchmarks
         done += n;
       }
     return {best.wall * steps, best.cpu * steps, best.total, best.total_cpu};
+  }
+
+  /**
+   * Command line shared by the case-based benchmarks: `--case NAME` (a
+   * preset), `--dim D --m M --nodes N` (one custom case named "Dd_mM"),
+   * `--steps`, `--seconds`, `--help`. @p extra handles the benchmark's own
+   * flags and returns false for an unknown one.
+   */
+  template <typename Options, typename Preset, typename Extra>
+  void
+  parse_case_options(int argc, char **argv, const char *program, Options &opt, Preset preset, Extra extra)
+  {
+    typename decltype(opt.cases)::value_type custom;
+    bool                                     have_custom = false;
+    for (int a = 1; a < argc; ++a)
+      {
+        const std::string                 arg  = argv[a];
+        const std::function<std::string()> next = [&]() -> std::string {
+          if (a + 1 >= argc)
+            throw std::runtime_error("missing value after " + arg);
+          return argv[++a];
+        };
+        if (arg == "--case")
+          opt.cases.push_back(preset(next()));
+        else if (arg == "--dim")
+          custom.dim = std::stoi(next()), have_custom = true;
+        else if (arg == "--m")
+          custom.m = std::stoi(next()), have_custom = true;
+        else if (arg == "--nodes")
+          custom.nodes = std::stod(next()), have_custom = true;
+        else if (arg == "--steps")
+          opt.steps = std::stoi(next());
+        else if (arg == "--seconds")
+          opt.seconds = std::stod(next());
+        else if (arg == "--help" || arg == "-h")
+          {
+            std::printf("see the header of contrib/benchmarks/%s.cc\n", program);
+            std::exit(0);
+          }
+        else if (!extra(arg, next))
+          throw std::runtime_error("unknown argument " + arg);
+      }
+    if (have_custom)
+      {
+        if (custom.dim < 2 || custom.dim > 3)
+          throw std::runtime_error("--dim must be 2 or 3");
+        custom.name = std::to_string(custom.dim) + "d_m" + std::to_string(custom.m);
+        opt.cases.push_back(custom);
+      }
   }
 } // namespace PeriDEALBenchmarks
 

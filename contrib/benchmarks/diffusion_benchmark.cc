@@ -284,48 +284,17 @@ namespace
   Options
   parse(int argc, char **argv)
   {
-    Options      opt;
-    Case         custom;
-    bool         have_custom = false;
-    for (int a = 1; a < argc; ++a)
-      {
-        const std::string arg  = argv[a];
-        auto              next = [&]() -> std::string {
-          if (a + 1 >= argc)
-            throw std::runtime_error("missing value after " + arg);
-          return argv[++a];
-        };
-        if (arg == "--case")
-          opt.cases.push_back(preset(next()));
-        else if (arg == "--dim")
-          custom.dim = std::stoi(next()), have_custom = true;
-        else if (arg == "--m")
-          custom.m = std::stoi(next()), have_custom = true;
-        else if (arg == "--nodes")
-          custom.nodes = std::stod(next()), have_custom = true;
-        else if (arg == "--steps")
-          opt.steps = std::stoi(next());
-        else if (arg == "--seconds")
-          opt.seconds = std::stod(next());
-        else if (arg == "--layer")
-          opt.layer = true;
-        else if (arg == "--profile-apply")
-          opt.profile_apply = std::stoi(next());
-        else if (arg == "--help" || arg == "-h")
-          {
-            std::printf("see the header of contrib/benchmarks/diffusion_benchmark.cc\n");
-            std::exit(0);
-          }
-        else
-          throw std::runtime_error("unknown argument " + arg);
-      }
-    if (have_custom)
-      {
-        if (custom.dim < 2 || custom.dim > 3)
-          throw std::runtime_error("--dim must be 2 or 3");
-        custom.name = std::to_string(custom.dim) + "d_m" + std::to_string(custom.m);
-        opt.cases.push_back(custom);
-      }
+    Options opt;
+    parse_case_options(argc, argv, "diffusion_benchmark", opt, preset,
+                       [&](const std::string &arg, const std::function<std::string()> &next) {
+                         if (arg == "--layer")
+                           opt.layer = true;
+                         else if (arg == "--profile-apply")
+                           opt.profile_apply = std::stoi(next());
+                         else
+                           return false;
+                         return true;
+                       });
     if (opt.cases.empty())
       for (const char *name : {"2d_m3", "2d_m12", "3d_m3", "3d_m12"})
         opt.cases.push_back(preset(name));

@@ -368,51 +368,20 @@ namespace
   parse(int argc, char **argv)
   {
     Options opt;
-    Case    custom;
-    bool    have_custom = false;
-    for (int a = 1; a < argc; ++a)
-      {
-        const std::string arg  = argv[a];
-        auto              next = [&]() -> std::string {
-          if (a + 1 >= argc)
-            throw std::runtime_error("missing value after " + arg);
-          return argv[++a];
-        };
-        if (arg == "--case")
-          opt.cases.push_back(preset(next()));
-        else if (arg == "--dim")
-          custom.dim = std::stoi(next()), have_custom = true;
-        else if (arg == "--m")
-          custom.m = std::stoi(next()), have_custom = true;
-        else if (arg == "--nodes")
-          custom.nodes = std::stod(next()), have_custom = true;
-        else if (arg == "--steps")
-          opt.steps = std::stoi(next());
-        else if (arg == "--seconds")
-          opt.seconds = std::stod(next());
-        else if (arg == "--profile-steps")
-          opt.profile_steps = std::stoi(next());
-        else if (arg == "--agreement")
-          opt.agreement_file = next();
-        else if (arg == "--agreement-steps")
-          opt.agreement_steps = std::stoi(next());
-        else if (arg == "--every")
-          opt.every = std::max(1, std::stoi(next()));
-        else if (arg == "--help" || arg == "-h")
-          {
-            std::printf("see the header of contrib/benchmarks/pmb_benchmark.cc\n");
-            std::exit(0);
-          }
-        else
-          throw std::runtime_error("unknown argument " + arg);
-      }
-    if (have_custom)
-      {
-        if (custom.dim < 2 || custom.dim > 3)
-          throw std::runtime_error("--dim must be 2 or 3");
-        custom.name = std::to_string(custom.dim) + "d_m" + std::to_string(custom.m);
-        opt.cases.push_back(custom);
-      }
+    parse_case_options(argc, argv, "pmb_benchmark", opt, preset,
+                       [&](const std::string &arg, const std::function<std::string()> &next) {
+                         if (arg == "--profile-steps")
+                           opt.profile_steps = std::stoi(next());
+                         else if (arg == "--agreement")
+                           opt.agreement_file = next();
+                         else if (arg == "--agreement-steps")
+                           opt.agreement_steps = std::stoi(next());
+                         else if (arg == "--every")
+                           opt.every = std::max(1, std::stoi(next()));
+                         else
+                           return false;
+                         return true;
+                       });
     if (opt.cases.empty() && opt.agreement_file.empty())
       for (const char *name : {"2d_m3", "2d_m12", "2d_m24", "3d_m3", "3d_m12"})
         opt.cases.push_back(preset(name));
