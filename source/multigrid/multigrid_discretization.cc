@@ -645,19 +645,120 @@ namespace PeriDEAL
       // interpolation coupling the off-diagonal entries are >= 0 (weights
       // >= 0) and the rows sum to 0, and we use the sharper max-principle
       // bound 1 / |L_ii| (the update is then a convex combination).
+      check_parameter(prm.coarse_quadrature == "standard" || prm.coarse_quadrature == "wls",
+                      "Multi-grid/Coarse quadrature", prm.coarse_quadrature,
+                      "'standard' or 'wls'");
+      check_parameter(prm.coarse_quadrature == "standard" ||
+                        (prm.scheme == "forward Euler" && !prm.conservative),
+                      "Multi-grid/Coarse quadrature", prm.coarse_quadrature,
+                      "'standard' with backward Euler or the conservative coupling");
+      constrained.assign(disc.n_active(), 0);
+      wls_row.assign(disc.n_active(), -1);
+      if (prm.coarse_quadrature == "wls")
+        {
+          // rows: coarse active nodes with the complete coarse family (the
+          // box boundary truncates the others, which keep their bonds)
+          const std::size_t full = stencil<dim>(p.coarse_dx, p.delta, p.partial_volume).size();
+          std::vector<std::uint64_t> family_start(disc.n_nodes() + 1, 0);
+          std::vector<std::int32_t>  family;
+          std::vector<unsigned int>  rows;
+          for (unsigned int i = 0; i < disc.n_nodes(); ++i)
+            {
+              if (i < disc.n_active())
+                {
+                  family.insert(family.end(), disc.col.begin() + disc.row_start[i],
+                                disc.col.begin() + disc.row_start[i + 1]);
+                  if (disc.grid[i] == disc.coarse &&
+                      disc.row_start[i + 1] - disc.row_start[i] == full)
+                    rows.push_back(i);
+                }
+              family_start[i + 1] = family.size();
+            }
+          wls = std::make_unique<WlsQuadrature<dim>>(prm.wls, kernel);
+          wls->build(disc.position, family_start, family, rows);
+          for (unsigned int k = 0; k < rows.size(); ++k)
+            wls_row[rows[k]] = k;
+        }
+
+      // Gershgorin bound of the (fictitious-expanded) operator with the
+      // largest kappa on every bond, min_i 2 / (|L_ii| + R_i). For the
+      // interpolation coupling the off-diagonal entries are >= 0 (weights
+      // >= 0) and the rows sum to 0, and we use the sharper max-principle
+      // bound 1 / |L_ii| (the update is then a convex combination).
       std::vector<double> diag(disc.n_active(), 0.), off(disc.n_active(), 0.);
-      {
-        std::map<std::pair<unsigned int, unsigned int>, double> L;
-        for (const auto &[r, c, v] : operator_entries(true, true))
-          L[{r, c}] += v;
-        for (const auto &[rc, v] : L)
-          (rc.first == rc.second ? diag[rc.first] : off[rc.first]) += std::abs(v);
-      }
+      if (prm.conservative)
+        {
+          std::map<std::pair<unsigned int, unsigned int>, double> L;
+          for (const auto &[r, c, v] : operator_entries(true, true))
+            L[{r, c}] += v;
+          for (const auto &[rc, v] : L)
+            (rc.first == rc.second ? diag[rc.first] : off[rc.first]) += std::abs(v);
+        }
+      else
+        {
+          // the same row by row (entries of row i only come from row i's
+          // bonds): no global map, which 3D lattices could not afford
+          const double kmax = prm.corrosion ? std::max({prm.kappa_liquid, prm.kappa_interface,
+                                                        prm.kappa_solid}) :
+                                              prm.kappa;
+          const unsigned int                        na = disc.n_active();
+          std::vector<std::pair<unsigned int, double>> row;
+          for (unsigned int i = 0; i < na; ++i)
+            {
+              row.clear();
+              for (unsigned int b = disc.row_start[i]; b < disc.row_start[i + 1]; ++b)
+                {
+                  const unsigned int j = disc.col[b];
+                  const double       c = kmax * kernel_weight[b];
+                  row.emplace_back(i, -c);
+                  if (j < na)
+                    row.emplace_back(j, c);
+                  else
+                    for (const auto &[a, w] : disc.active_interpolation[j - na])
+                      row.emplace_back(a, c * w);
+                }
+              std::sort(row.begin(), row.end(),
+                        [](const auto &x, const auto &y) { return x.first < y.first; });
+              for (std::size_t k = 0; k < row.size();)
+                {
+                  double             v = 0.;
+                  const unsigned int c = row[k].first;
+                  for (; k < row.size() && row[k].first == c; ++k)
+                    v += row[k].second;
+                  (c == i ? diag[i] : off[i]) += std::abs(v);
+                }
+            }
+        }
       dt_critical = std::numeric_limits<double>::infinity();
       for (unsigned int i = 0; i < disc.n_active(); ++i)
         if (diag[i] > 0.)
           dt_critical = std::min(dt_critical, prm.conservative ? 2. / (diag[i] + off[i]) :
                                                                  1. / diag[i]);
+      // WLS rows (kappa_liquid or kappa; weights of both signs): Gershgorin
+      // 2 / (|L_ii| + R_i), fictitious columns expanded (|w| summed)
+      if (wls)
+        {
+          const double kw = prm.corrosion ? prm.kappa_liquid : prm.kappa;
+          for (unsigned int k = 0; k < wls->node.size(); ++k)
+            {
+              const unsigned int i = wls->node[k];
+              double             d = 0., r = 0.;
+              for (auto q = wls->row_start[k]; q < wls->row_start[k + 1]; ++q)
+                {
+                  const unsigned int j = wls->col[q];
+                  const double       w = kw * wls->weight[q];
+                  if (j == i)
+                    d += w;
+                  else if (j < disc.n_active())
+                    r += std::abs(w);
+                  else
+                    for (const auto &[a, v] : disc.active_interpolation[j - disc.n_active()])
+                      (a == i ? d : r) += a == i ? w * v : std::abs(w * v);
+                }
+              if (std::abs(d) + r > 0.)
+                dt_critical = std::min(dt_critical, 2. / (std::abs(d) + r));
+            }
+        }
 
       dt          = prm.time_step > 0. ? prm.time_step : 0.9 * dt_critical;
       if (prm.scheme == "forward Euler")
@@ -699,8 +800,29 @@ namespace PeriDEAL
     {
       const unsigned int na = disc.n_active();
       out.assign(na, 0.);
+      n_wls_used = 0;
       for (unsigned int i = 0; i < na; ++i)
         {
+          if (constrained[i])
+            continue;
+          if (wls_row[i] >= 0)
+            {
+              // WLS row, valid while the diffusivity is uniform on it
+              const unsigned int k     = wls_row[i];
+              bool               solid = false;
+              double             s     = 0.;
+              for (auto q = wls->row_start[k]; q < wls->row_start[k + 1] && !solid; ++q)
+                {
+                  solid = prm.corrosion && phase[wls->col[q]] > 0.5;
+                  s += wls->weight[q] * v[wls->col[q]];
+                }
+              if (!solid)
+                {
+                  out[i] += (prm.corrosion ? prm.kappa_liquid : prm.kappa) * s;
+                  ++n_wls_used;
+                  continue;
+                }
+            }
           const bool skip_fictitious = prm.conservative && disc.grid[i] == disc.coarse;
           const bool pay_back        = prm.conservative && disc.grid[i] == disc.fine;
           double     s               = 0.;
@@ -814,6 +936,8 @@ namespace PeriDEAL
                       ExcMessage("multi-grid backward Euler: factorization failed"));
           implicit->valid = true;
         }
+      AssertThrow(std::none_of(constrained.begin(), constrained.end(), [](char c) { return c; }),
+                  ExcMessage("multi-grid backward Euler: constrained nodes not supported"));
       Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
       for (unsigned int i = 0; i < disc.n_active(); ++i)
         rhs[i] = C[i] / dt;

@@ -13,7 +13,10 @@
 
 #include "../check.h"
 
+#include <array>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <iostream>
 #include <vector>
 
@@ -701,6 +704,103 @@ end
     check(bec.max_mass_change < 1e-12,
           "conservative backward Euler: max relative mass change " + sci(bec.max_mass_change));
   }
+
+  // ---------------------------------------------------------------------
+  // 3D corrosion with the hybrid fixed configuration, dissertation Sect.
+  // 3.3.2 (E4) at a reduced size: the source's material and discretization
+  // (kappa_liq = 0.0126, kappa_int = 0.0029 s^-1 mm^-2, C_sat = 5100,
+  // C_solid = 143000 mol/m^3, q = 1, delta = 0.6 mm, dx = 0.1 mm, m = 6,
+  // WLS-2 with n_c = 123), the Stanford bunny replaced by a solid ball of
+  // radius r_s in a liquid ball of radius R (C = 0 on a layer of thickness
+  // delta outside it, as the source's "C = 0 within delta of the sphere").
+  // Omega_s (standard scheme) = the shell |x| < r_s + w around the solid,
+  // where the phase interface lives; WLS-2 elsewhere.
+  std::string
+  corrosion_3d_hybrid_parameters(const double R, const double r_s, const double dt,
+                                 const double end_time, const std::string &hybrid)
+  {
+    std::ostringstream s;
+    s.precision(17);
+    s << "subsection Geometry\n set Domain = ball\n set Center = 0, 0, 0\n set Radius = " << R
+      << "\nend\n"
+      << "subsection Discretization\n set Grid spacing = 0.1\n set Horizon = 0.6\n"
+      << " set Lattice = cell centered\n set Volume constraint layer = -1\nend\n"
+      << "subsection Model\n set Type = corrosion\n set Kernel exponent = 1\n"
+      << " set Initial condition = 143000 * (x^2 + y^2 + z^2 < " << r_s * r_s << ")\n"
+      << " subsection Corrosion\n  set Liquid micro-diffusivity = 0.0126\n"
+      << "  set Interface micro-diffusivity = 0.0029\n  set Saturation concentration = 5100\n"
+      << " end\nend\n"
+      << "subsection Time stepping\n set End time = " << end_time << "\n set Time step = " << dt
+      << "\nend\nsubsection Output\n set Time series interval = 1000000\nend\n"
+      << "subsection Hybrid\n" << hybrid << "end\n";
+    return s.str();
+  }
+
+  std::string
+  corrosion_3d_hybrid_region(const double r_s, const double w)
+  {
+    std::ostringstream s;
+    s.precision(17);
+    s << " set Quadrature = hybrid\n set Standard region = x^2 + y^2 + z^2 < "
+      << (r_s + w) * (r_s + w) << "\n";
+    return s.str();
+  }
+
+  void
+  hybrid_corrosion_3d()
+  {
+    const double R = 0.9, r_s = 0.45, dt = 6., end = 1200.;
+    std::vector<std::vector<double>> loss(2);
+    std::array<double, 2>            seconds{};
+    types::global_dof_index          n_wls = 0, n_nodes = 0;
+    for (unsigned int h = 0; h < 2; ++h)
+      {
+        DiffusionSolver<3> solver(MPI_COMM_WORLD,
+                                  parameters_from_text<DiffusionRunParameters<3>>(
+                                    corrosion_3d_hybrid_parameters(
+                                      R, r_s, dt, end,
+                                      h ? corrosion_3d_hybrid_region(r_s, 0.3) : "")));
+        solver.setup();
+        const double v0 = solver.diagnostics().solid_volume;
+        Timer        timer;
+        while (solver.step() < solver.n_steps())
+          {
+            solver.advance();
+            loss[h].push_back(1. - solver.diagnostics().solid_volume / v0);
+          }
+        seconds[h] = timer.wall_time();
+        if (h)
+          n_wls = solver.n_wls_rows();
+        else
+          n_nodes = solver.discretization().n_global();
+        if (root() && h == 0)
+          std::cout << "  dt_critical " << solver.critical_time_step() << std::endl;
+      }
+    double max_diff = 0., mean_diff = 0., max_jump = 0.;
+    for (unsigned int k = 0; k < loss[0].size(); ++k)
+      {
+        max_diff = std::max(max_diff, std::abs(loss[0][k] - loss[1][k]));
+        mean_diff += std::abs(loss[0][k] - loss[1][k]) / loss[0].size();
+        if (k > 0)
+          max_jump = std::max(max_jump, loss[0][k] - loss[0][k - 1]);
+      }
+    if (root())
+      {
+        std::cout << "  " << n_nodes << " nodes, WLS-2 on " << n_wls
+                  << "; relative volume loss standard/hybrid every " << loss[0].size() / 10
+                  << " steps:";
+        for (unsigned int k = loss[0].size() / 10 - 1; k < loss[0].size(); k += loss[0].size() / 10)
+          std::cout << " " << std::setprecision(3) << loss[0][k] << "/" << loss[1][k];
+        std::cout << ", final " << loss[0].back() << "/" << loss[1].back() << "; stepping "
+                  << seconds[0] << " / " << seconds[1] << " s" << std::endl;
+      }
+    check(loss[0].back() > 0.2, "the solid corrodes: final loss " + std::to_string(loss[0].back()));
+    check(mean_diff < 0.02, "time-averaged |loss difference| < 2 points: " +
+                              std::to_string(mean_diff));
+    check(max_diff <= max_jump * (1. + 1e-12),
+          "max difference " + std::to_string(max_diff) + " <= largest single-step jump " +
+            std::to_string(max_jump));
+  }
 } // namespace
 
 int
@@ -712,5 +812,6 @@ main(int argc, char **argv)
               {"consistency", consistency},
               {"diffusion_rod", diffusion_rod},
               {"interface_flux_2d", interface_flux_2d},
-              {"e5", e5}});
+              {"e5", e5},
+              {"hybrid_corrosion_3d", hybrid_corrosion_3d}});
 }

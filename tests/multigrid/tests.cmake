@@ -11,3 +11,6 @@ perideal_add_test(NAME multigrid.e5_corrosion_1d
 perideal_add_test(NAME tutorial.step-10
   COMMAND $<TARGET_FILE:step-10> ${CMAKE_SOURCE_DIR}/tutorial/step-10/step-10.prm
   LABELS tutorial TIMEOUT 600)
+# 3D corrosion, hybrid fixed configuration vs standard (Sect. 3.3.2, reduced)
+perideal_add_test(NAME multigrid.hybrid_corrosion_3d
+  COMMAND $<TARGET_FILE:multigrid_tests> hybrid_corrosion_3d LABELS unit)

@@ -4,7 +4,9 @@
 #include <deal.II/base/point.h>
 
 #include <perideal/base/kernel.h>
+#include <perideal/discretization/wls_quadrature.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -249,6 +251,18 @@ namespace PeriDEAL
        */
       bool calibrate = false;
       double      time_step = 0.;           ///< 0: 0.9 x the stability bound
+      /**
+       * Quadrature of the coarse active rows: "standard" (the bonds of
+       * (3.84)) or "wls", the WLS collocation quadrature of Sect. 3.2 on
+       * every coarse active node with a complete coarse family (the
+       * "adaptive, hybrid" configuration of Sect. 3.5 and [100] Example 2:
+       * WLS in Omega+, standard in Omega-). In corrosion a WLS row falls
+       * back to its bonds while any of its collocation nodes is solid (the
+       * bond diffusivity is then not uniform). Forward Euler with the
+       * interpolation coupling only.
+       */
+      std::string   coarse_quadrature = "standard";
+      WlsParameters wls;
     };
 
     /**
@@ -279,6 +293,36 @@ namespace PeriDEAL
       }
       void
       initialize_phase();
+
+      /**
+       * Hold the active nodes where @p inside(x) is true at their current
+       * value (a Dirichlet volume constraint, e.g. C = 0 within delta of the
+       * electrolyte's outer surface): their rows are not evaluated.
+       */
+      template <typename F>
+      void
+      set_constrained(const F &inside)
+      {
+        for (unsigned int i = 0; i < disc.n_active(); ++i)
+          constrained[i] = inside(disc.position[i]);
+      }
+      unsigned int
+      n_constrained() const
+      {
+        return std::count(constrained.begin(), constrained.end(), char(1));
+      }
+      /** Coarse active rows with WLS weights (0 for the standard quadrature). */
+      unsigned int
+      n_wls_rows() const
+      {
+        return wls ? wls->node.size() : 0;
+      }
+      /** WLS rows whose last evaluation used the weights (not the bonds). */
+      unsigned int
+      n_wls_rows_used() const
+      {
+        return n_wls_used;
+      }
 
       /** One time step. */
       void
@@ -359,6 +403,10 @@ namespace PeriDEAL
       unsigned int               n_step = 0;
       struct Implicit;
       std::unique_ptr<Implicit> implicit;
+      std::vector<char>         constrained; ///< per active node
+      std::unique_ptr<WlsQuadrature<dim>> wls; ///< coarse WLS rows
+      std::vector<int>          wls_row;       ///< per active node: row of wls or -1
+      mutable unsigned int      n_wls_used = 0;
     };
   } // namespace MultiGrid
 } // namespace PeriDEAL
