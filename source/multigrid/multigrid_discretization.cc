@@ -1,3 +1,5 @@
+#include <deal.II/base/timer.h>
+
 #include <perideal/base/exceptions.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/multigrid/multigrid_discretization.h>
@@ -966,6 +968,95 @@ namespace PeriDEAL
       update_phase();
       t += dt;
       ++n_step;
+    }
+
+
+    CylinderCorrosionCase::CylinderCorrosionCase()
+    {
+      transport.corrosion       = true;
+      transport.kappa_liquid    = 2.;
+      transport.kappa_interface = 0.1;
+      transport.saturation      = 0.85;
+    }
+
+    CorrosionHistory
+    run_cylinder_corrosion(const CylinderCorrosionCase &c, const std::string &configuration,
+                           const unsigned int max_steps)
+    {
+      check_parameter(configuration == "uniform fine" || configuration == "uniform coarse" ||
+                        configuration == "multi-grid" || configuration == "adaptive hybrid",
+                      "Configuration", configuration,
+                      "'uniform fine', 'uniform coarse', 'multi-grid' or 'adaptive hybrid'");
+      const double H = c.ratio * c.fine_dx, h = c.fine_dx, L = c.half_width;
+      check_parameter(std::abs(L / H - std::round(L / H)) < 1e-9 * L / H, "Half width", L,
+                      "a multiple of the coarse spacing " + std::to_string(H));
+      Parameters<3> p;
+      p.delta    = c.delta;
+      p.exponent = 1.;
+      if (configuration == "uniform fine")
+        {
+          // the multi-grid's fine nodes: odd multiples of h/2
+          p.coarse_dx = p.fine_dx = h;
+          for (unsigned int d = 0; d < 3; ++d)
+            {
+              p.lower[d] = -L - h / 2.;
+              p.upper[d] = L + h / 2.;
+            }
+        }
+      else
+        {
+          p.coarse_dx = H;
+          p.fine_dx   = configuration == "uniform coarse" ? H : h;
+          for (unsigned int d = 0; d < 3; ++d)
+            {
+              p.lower[d] = -L;
+              p.upper[d] = L;
+            }
+          if (configuration != "uniform coarse")
+            p.fine_region = Region<3>::cylinder(Point<3>(), c.radius + c.fine_margin,
+                                                c.half_height + c.fine_margin);
+        }
+      CorrosionHistory r;
+      Timer            timer;
+      const Discretization<3> disc(p);
+      TransportParameters     t = c.transport;
+      t.time_step               = c.time_step;
+      if (configuration == "adaptive hybrid")
+        t.coarse_quadrature = "wls";
+      TransportSolver<3> solver(disc, t);
+      solver.set_initial([&](const Point<3> &x) {
+        return x[0] * x[0] + x[1] * x[1] < c.radius * c.radius &&
+                   std::abs(x[2]) < c.half_height ?
+                 1. :
+                 0.;
+      });
+      // C = 0 within delta of the faces of the electrolyte cube [-L, L]^3
+      // (its cells reach L + H/2)
+      const double inner = L + H / 2. - c.delta;
+      solver.set_constrained([&](const Point<3> &x) {
+        return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])}) > inner;
+      });
+      r.setup_seconds   = timer.wall_time();
+      r.n_active_coarse = disc.n_active_coarse;
+      r.n_active_fine   = disc.n_active_fine;
+      r.n_fictitious    = disc.n_fictitious_coarse + disc.n_fictitious_fine;
+      r.n_constrained   = solver.n_constrained();
+      r.n_wls_rows      = solver.n_wls_rows();
+      r.time_step       = solver.time_step();
+      const double v0   = solver.solid_volume();
+      r.time.push_back(0.);
+      r.loss.push_back(0.);
+      Timer step_timer;
+      while (solver.time() < c.end_time - 1e-9 * solver.time_step() &&
+             (max_steps == 0 || solver.step() < max_steps))
+        {
+          solver.advance();
+          r.time.push_back(solver.time());
+          r.loss.push_back(1. - solver.solid_volume() / v0);
+        }
+      r.step_seconds     = step_timer.wall_time() / std::max(1u, solver.step());
+      r.step_cpu_seconds = step_timer.cpu_time() / std::max(1u, solver.step());
+      return r;
     }
 
     template struct Region<1>;

@@ -14,3 +14,7 @@ perideal_add_test(NAME tutorial.step-10
 # 3D corrosion, hybrid fixed configuration vs standard (Sect. 3.3.2, reduced)
 perideal_add_test(NAME multigrid.hybrid_corrosion_3d
   COMMAND $<TARGET_FILE:multigrid_tests> hybrid_corrosion_3d LABELS unit)
+# 3D multi-grid corrosion (reduced [100] Example 2): uniform fine vs
+# multi-grid vs adaptive hybrid (WLS on the coarse grid)
+perideal_add_test(NAME multigrid.corrosion_3d
+  COMMAND $<TARGET_FILE:multigrid_tests> corrosion_3d LABELS unit)

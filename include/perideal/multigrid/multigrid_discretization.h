@@ -408,6 +408,52 @@ namespace PeriDEAL
       std::vector<int>          wls_row;       ///< per active node: row of wls or -1
       mutable unsigned int      n_wls_used = 0;
     };
+
+    /**
+     * A reduced analogue of the 3D bio-corrosion example of [100] (Example 2,
+     * dissertation Sect. 3.5.2): a solid cylinder (the screw without thread
+     * and slot; axis z, C = 1) in a cubic electrolyte (C = 0) held at C = 0
+     * within delta of its outer faces, bi-material corrosion with the
+     * one-way phase rule, forward Euler. Omega- is a cylinder around the
+     * solid, enlarged by @p fine_margin, fixed in time. The material is that
+     * of the 1D example E5 (kappa_liq = 2, kappa_int = 0.1, C_sat = 0.85,
+     * q = 1): with the source's C_sat / C_solid = 1e-5 a surface node needs
+     * thousands of steps to dissolve.
+     */
+    struct CylinderCorrosionCase
+    {
+      double half_width  = 1.05;  ///< the cube [-L, L]^3 of coarse nodes (L multiple of dx+)
+      double radius      = 0.3;   ///< solid cylinder
+      double half_height = 0.45;
+      double fine_margin = 0.45;  ///< Omega- = solid cylinder enlarged by this
+      double fine_dx     = 0.075;
+      unsigned int ratio = 2;     ///< dx+ = ratio dx-
+      double delta       = 0.45;
+      double end_time    = 1.;
+      double time_step   = 0.;    ///< 0: 0.9 x the bound of the uniform fine model
+      TransportParameters transport; ///< corrosion = true, E5's material by default
+      CylinderCorrosionCase();
+    };
+
+    /** Node counts, relative volume loss history and timing of one run. */
+    struct CorrosionHistory
+    {
+      unsigned int n_active_coarse = 0, n_active_fine = 0, n_fictitious = 0,
+                   n_constrained = 0, n_wls_rows = 0;
+      double setup_seconds = 0., step_seconds = 0., step_cpu_seconds = 0., time_step = 0.;
+      std::vector<double> time, loss; ///< loss = 1 - V_solid(t) / V_solid(0)
+    };
+
+    /**
+     * Run the case with @p configuration "uniform fine" (one lattice of
+     * spacing dx-, nodes at the fine nodes of the multi-grid), "uniform
+     * coarse" (dx+), "multi-grid" (standard quadrature on both grids) or
+     * "adaptive hybrid" (WLS on the coarse grid). @p max_steps > 0 stops
+     * earlier (timing runs).
+     */
+    CorrosionHistory
+    run_cylinder_corrosion(const CylinderCorrosionCase &c, const std::string &configuration,
+                           const unsigned int max_steps = 0);
   } // namespace MultiGrid
 } // namespace PeriDEAL
 
