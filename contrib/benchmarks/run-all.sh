@@ -15,6 +15,7 @@
 #               missing)
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
+#   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 10)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -49,13 +50,14 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
 pmb_exe="$build/contrib/benchmarks/pmb_benchmark"
 abc_exe="$build/contrib/benchmarks/abc_benchmark"
-for e in "$exe" "$pmb_exe" "$abc_exe"; do
+corrosion_exe="$build/contrib/benchmarks/corrosion_benchmark"
+for e in "$exe" "$pmb_exe" "$abc_exe" "$corrosion_exe"; do
   [ -x "$e" ] || { echo "run-all: $e was not built" >&2; exit 1; }
 done
 
@@ -272,6 +274,10 @@ EOF_LMP
 fi
 # EBF absorbing boundaries: ABC work as a fraction of the step time (serial).
 "$abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
+
+# 3D corrosion: hybrid vs standard, multi-grid / adaptive hybrid vs uniform
+# fine (serial; CORROSION_STEPS timed steps, default 10).
+"$corrosion_exe" --steps "${CORROSION_STEPS:-10}" | grep -v '^#' | tee -a "$results"
 
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"
 echo "run-all: results in $results" >&2
