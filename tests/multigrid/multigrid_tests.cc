@@ -165,6 +165,70 @@ namespace
       t.scheme = "Crank";
       MultiGrid::TransportSolver<1> s(d, t);
     });
+    expect("bad coarse quadrature", "Multi-grid/Coarse quadrature", [] {
+      MultiGrid::Discretization<1> d(e5_parameters<1>());
+      MultiGrid::TransportParameters t;
+      t.coarse_quadrature = "gauss";
+      MultiGrid::TransportSolver<1> s(d, t);
+    });
+    expect("coarse WLS with backward Euler", "Multi-grid/Coarse quadrature", [] {
+      MultiGrid::Discretization<1> d(e5_parameters<1>());
+      MultiGrid::TransportParameters t;
+      t.coarse_quadrature = "wls";
+      t.scheme            = "backward Euler";
+      MultiGrid::TransportSolver<1> s(d, t);
+    });
+    expect("unknown 3D corrosion configuration", "Configuration", [] {
+      MultiGrid::run_cylinder_corrosion(MultiGrid::CylinderCorrosionCase(), "adaptive");
+    });
+  }
+
+  // WLS-2 on the coarse grid (the "adaptive hybrid" rows) integrates
+  // quadratics exactly: for C = |x|^2 the PD operator int k(|xi|) (C(x+xi)
+  // - C(x)) dV = int k |xi|^2 dV = dim * M2 (M2 = ScalarKernel::second_moment,
+  // by quadrature) at every WLS row; the standard rows of the same lattice
+  // carry the quadrature error of the lattice (m = 3).
+  void
+  coarse_wls_exactness()
+  {
+    MultiGrid::Parameters<3> p;
+    p.lower     = Point<3>(-1., -1., -1.);
+    p.upper     = Point<3>(1., 1., 1.);
+    p.coarse_dx = p.fine_dx = 0.25;
+    p.delta                 = 0.75;
+    const MultiGrid::Discretization<3> d(p);
+    MultiGrid::TransportParameters     t;
+    t.kappa = 1.;
+    MultiGrid::TransportSolver<3> standard(d, t);
+    t.coarse_quadrature = "wls";
+    MultiGrid::TransportSolver<3> wls(d, t);
+    ScalarKernel k;
+    k.dim = 3;
+    k.exponent = 1.;
+    k.delta    = p.delta;
+    const double exact = 3. * k.second_moment();
+    std::vector<double> c(d.n_nodes()), rw, rs;
+    for (unsigned int i = 0; i < d.n_nodes(); ++i)
+      c[i] = d.position[i].square();
+    wls.apply(c, rw);
+    standard.apply(c, rs);
+    double ew = 0., es = 0.;
+    unsigned int interior = 0;
+    for (unsigned int i = 0; i < d.n_active(); ++i)
+      if (std::max({std::abs(d.position[i][0]), std::abs(d.position[i][1]),
+                    std::abs(d.position[i][2])}) <= 1. - p.delta + 1e-12)
+        {
+          ++interior;
+          ew = std::max(ew, std::abs(rw[i] - exact) / exact);
+          es = std::max(es, std::abs(rs[i] - exact) / exact);
+        }
+    std::cout << "  " << wls.n_wls_rows() << " WLS rows (" << interior
+              << " interior nodes); L|x|^2 = " << exact << ": max rel. error WLS-2 " << sci(ew)
+              << ", standard " << sci(es) << std::endl;
+    check(wls.n_wls_rows() == interior, "WLS rows = the nodes with a complete family");
+    check(wls.n_wls_rows_used() == interior, "all WLS rows used (diffusion)");
+    check(ew < 1e-8, "WLS-2 exact for quadratics (rel. error " + sci(ew) + ")");
+    check(es > 100. * ew, "the standard rows are not (" + sci(es) + ")");
   }
 
   // Max |rate| over active nodes whose horizon stays inside the body (a
@@ -843,5 +907,6 @@ main(int argc, char **argv)
               {"interface_flux_2d", interface_flux_2d},
               {"e5", e5},
               {"hybrid_corrosion_3d", hybrid_corrosion_3d},
-              {"corrosion_3d", corrosion_3d}});
+              {"corrosion_3d", corrosion_3d},
+              {"coarse_wls_exactness", coarse_wls_exactness}});
 }

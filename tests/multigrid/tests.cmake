@@ -1,6 +1,6 @@
 perideal_add_test_program(multigrid_tests ${CMAKE_CURRENT_LIST_DIR}/multigrid_tests.cc)
 
-foreach(_t node_counts bad_input consistency interface_flux_2d)
+foreach(_t node_counts bad_input consistency interface_flux_2d coarse_wls_exactness)
   perideal_add_test(NAME multigrid.${_t} COMMAND $<TARGET_FILE:multigrid_tests> ${_t}
     LABELS unit)
 endforeach()
