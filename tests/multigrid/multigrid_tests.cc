@@ -894,6 +894,42 @@ end
                 " <= largest single-step jump " + std::to_string(max_jump));
       }
   }
+
+  // The 3D hybrid corrosion run on all ranks against each rank alone: the
+  // relative volume-loss histories must be identical (same WLS weights and
+  // the same per-row summation; only the global sums differ by round-off).
+  void
+  hybrid_corrosion_3d_ranks()
+  {
+    const std::string text = corrosion_3d_hybrid_parameters(
+      0.9, 0.45, 6., 1020., corrosion_3d_hybrid_region(0.45, 0.3));
+    std::vector<std::vector<double>> loss(2);
+    std::array<types::global_dof_index, 2> n_wls{};
+    for (unsigned int k = 0; k < 2; ++k)
+      {
+        DiffusionSolver<3> solver(k ? MPI_COMM_SELF : MPI_COMM_WORLD,
+                                  parameters_from_text<DiffusionRunParameters<3>>(text));
+        solver.setup();
+        const double v0 = solver.diagnostics().solid_volume;
+        while (solver.step() < solver.n_steps())
+          {
+            solver.advance();
+            loss[k].push_back(1. - solver.diagnostics().solid_volume / v0);
+          }
+        n_wls[k] = solver.n_wls_rows();
+      }
+    double diff = 0.;
+    for (std::size_t i = 0; i < loss[0].size(); ++i)
+      diff = std::max(diff, std::abs(loss[0][i] - loss[1][i]));
+    diff = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "  " << Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)
+                << " rank(s): final loss " << loss[0].back() << ", WLS rows " << n_wls[0]
+                << std::endl;
+    check(n_wls[0] == n_wls[1] && n_wls[0] > 0, "same WLS rows on all ranks and alone");
+    check(loss[0].back() > 0.5, "the solid corrodes: loss " + std::to_string(loss[0].back()));
+    check(diff < 1e-12, "volume-loss histories all ranks vs one rank: max diff " + sci(diff));
+  }
 } // namespace
 
 int
@@ -908,5 +944,6 @@ main(int argc, char **argv)
               {"e5", e5},
               {"hybrid_corrosion_3d", hybrid_corrosion_3d},
               {"corrosion_3d", corrosion_3d},
-              {"coarse_wls_exactness", coarse_wls_exactness}});
+              {"coarse_wls_exactness", coarse_wls_exactness},
+              {"hybrid_corrosion_3d_ranks", hybrid_corrosion_3d_ranks}});
 }

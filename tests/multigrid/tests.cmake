@@ -18,3 +18,5 @@ perideal_add_test(NAME multigrid.hybrid_corrosion_3d
 # multi-grid vs adaptive hybrid (WLS on the coarse grid)
 perideal_add_test(NAME multigrid.corrosion_3d
   COMMAND $<TARGET_FILE:multigrid_tests> corrosion_3d LABELS unit)
+perideal_add_test(NAME multigrid.hybrid_corrosion_3d.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:multigrid_tests> hybrid_corrosion_3d_ranks LABELS "unit;mpi")
