@@ -773,7 +773,7 @@ end
   void
   hybrid_corrosion_3d()
   {
-    const double R = 0.9, r_s = 0.45, dt = 6., end = 1200.;
+    const double R = 0.9, r_s = 0.45, dt = 6., end = 1020.;
     std::vector<std::vector<double>> loss(2);
     std::array<double, 2>            seconds{};
     types::global_dof_index          n_wls = 0, n_nodes = 0;
