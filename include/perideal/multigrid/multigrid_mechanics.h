@@ -144,7 +144,11 @@ namespace PeriDEAL
       add_prescribed_velocity(const std::function<bool(const Point<dim> &)> &region,
                               const Tensor<1, dim>                          &v);
 
-      /** Critical time step (3.8) over both grids' active stencils (WLS: its row norm). */
+      /**
+       * Critical time step: (3.8) for the standard scheme of each grid in
+       * use, and for the WLS stencil the exact limit 2 sqrt(rho / lambda_max)
+       * of its Fourier symbol.
+       */
       double
       critical_time_step() const;
       void
@@ -327,6 +331,8 @@ namespace PeriDEAL
       /** The WLS stencil: lattice offset and dim x dim weights (row-major). */
       std::vector<long>   wls_offset;
       std::vector<double> wls_weight;
+      /** Stability limit of velocity Verlet with the WLS stencil (its symbol). */
+      double wls_stable_step = 0.;
       /** Interpolation rows: node, then sources/weights (CSR) for each grid's fictitious list. */
       std::array<std::vector<unsigned int>, 2> interp_start, interp_source;
       std::array<std::vector<double>, 2>       interp_weight;
@@ -401,6 +407,25 @@ namespace PeriDEAL
       /** Largest distance of a damaged (>= 0.35) fine node of that region from the tip. */
       double
       crack_length(const MechanicsSolver<2> &solver) const;
+
+      /** What run() measures. */
+      struct Result
+      {
+        unsigned int coarse_begin = 0, fine_begin = 0, coarse_end = 0, fine_end = 0;
+        unsigned int steps = 0, switches = 0, crack_nodes = 0;
+        double       angle = 0., length = 0.;
+        /** Wall time of the time loop (setup excluded) [s]. */
+        double seconds = 0.;
+        /** MechanicsSolver::timing: forces, interpolation, switching test, switching. */
+        std::array<double, 4> timing{{0., 0., 0., 0.}};
+      };
+      /**
+       * Set up, load and run to end_time; @p monitor (if set) is called
+       * after setup and every @p interval steps and at the end (not timed).
+       */
+      Result
+      run(const std::function<void(const MechanicsSolver<2> &)> &monitor  = {},
+          const unsigned int                                     interval = 0) const;
     };
   } // namespace MultiGrid
 } // namespace PeriDEAL
