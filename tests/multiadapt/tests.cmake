@@ -5,3 +5,6 @@ perideal_add_test_program(multiadapt_tests ${CMAKE_CURRENT_LIST_DIR}/multiadapt_
 foreach(_t patch mass_momentum wave kw bad_input)
   perideal_add_test(NAME multiadapt.${_t} COMMAND $<TARGET_FILE:multiadapt_tests> ${_t} LABELS unit)
 endforeach()
+# tutorial/step-11 (multi-adaptive Kalthoff-Winkler) with a reduced parameter file.
+perideal_add_test(NAME tutorial.step-11 COMMAND $<TARGET_FILE:step-11>
+  ${CMAKE_CURRENT_LIST_DIR}/step-11-ci.prm LABELS "tutorial" TIMEOUT 600)
