@@ -16,6 +16,7 @@
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
 #   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 10)
+#   KW_ARGS     options of kw_multiadaptive_benchmark (default: its CI-size case)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -50,7 +51,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
@@ -278,6 +279,13 @@ fi
 # 3D corrosion: hybrid vs standard, multi-grid / adaptive hybrid vs uniform
 # fine (serial; CORROSION_STEPS timed steps, default 10).
 "$corrosion_exe" --steps "${CORROSION_STEPS:-10}" | grep -v '^#' | tee -a "$results"
+# Multi-adaptive Kalthoff-Winkler (serial): Table 1 of paper 001 at
+# KW_ARGS (default dx+ = 2 dx- = 1 mm, delta = 4 mm).
+kw_exe="$build/contrib/benchmarks/kw_multiadaptive_benchmark"
+if [ -x "$kw_exe" ]; then
+  # shellcheck disable=SC2086
+  "$kw_exe" ${KW_ARGS:-} | grep '^kw_' | tee -a "$results"
+fi
 
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"
 echo "run-all: results in $results" >&2

@@ -1,0 +1,433 @@
+#ifndef perideal_multigrid_multigrid_mechanics_h
+#define perideal_multigrid_multigrid_mechanics_h
+
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <perideal/base/kernel.h>
+#include <perideal/multigrid/multigrid_discretization.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace PeriDEAL
+{
+  using namespace dealii;
+
+  namespace MultiGrid
+  {
+    /**
+     * Which model the two-grid mechanics solver runs (multi-adaptive paper
+     * 001, Sect. 4.1): the standard scheme on one uniform grid, or the
+     * multi-grid coupling of dissertation Sect. 3.4 with the switching of
+     * Sect. 3.5, the coarse grid discretized by the standard scheme
+     * ("adaptive, standard") or by WLS collocation ("adaptive, hybrid").
+     */
+    enum class MechanicsModel
+    {
+      uniform_fine,
+      uniform_coarse,
+      adaptive_standard,
+      adaptive_hybrid
+    };
+
+    /** Parse "uniform fine", "uniform coarse", "adaptive standard", "adaptive hybrid". */
+    MechanicsModel
+    parse_mechanics_model(const std::string &name, const std::string &parameter = "Model");
+    std::string
+    to_string(const MechanicsModel model);
+
+    /**
+     * Parameters of explicit bond-based (PMB) elasticity on a fine/coarse
+     * lattice pair over the box [lower, upper]: cell-centred coarse nodes of
+     * spacing coarse_dx, each coarse cell split into r^dim fine cells
+     * (r = coarse_dx / fine_dx an integer) with cell-centred fine nodes.
+     * Both grids use the same horizon and the same micromodulus/critical
+     * stretch (bond_based_micromodulus(), bond_based_critical_stretch()).
+     */
+    template <int dim>
+    struct MechanicsParameters
+    {
+      Point<dim> lower, upper;
+      double     coarse_dx = 2., fine_dx = 1., delta = 4.;
+      bool       partial_volume = true;
+      MechanicsModel model      = MechanicsModel::adaptive_hybrid;
+      /** How fictitious nodes get their values; (3.85)-(3.88) by default. */
+      Interpolation interpolation = Interpolation::inverse_distance;
+
+      InfluenceFunction omega          = InfluenceFunction::constant;
+      double            youngs_modulus = 1.;
+      bool              plane_stress   = false;
+      double            density        = 1.;
+      /** G0 (0 and critical_stretch 0: bonds never break). */
+      double fracture_energy = 0.;
+      /** s0, used as given if > 0. */
+      double critical_stretch = 0.;
+
+      /** WLS collocation on the coarse grid (hybrid): order and n_c (0: default). */
+      unsigned int wls_order = 2, n_collocation = 49;
+      /** sigma of the switching criterion (3.80). */
+      double switching_sigma = 0.95;
+      /**
+       * Coarse cells (given by their node) refined at t = 0 in the adaptive
+       * models; empty: none.
+       */
+      std::function<bool(const Point<dim> &)> initial_fine_region;
+
+      /** Throws ParameterError naming the entry for inadmissible values. */
+      void
+      check() const;
+    };
+
+    /**
+     * Explicit bond-based PD elasticity on two lattices coupled by
+     * fictitious nodes (dissertation Sect. 3.4, (3.81)-(3.88)) with the
+     * multi-adaptive switching of Sect. 3.5 / paper 001 Sect. 3.
+     *
+     * Every coarse cell is either coarse (its coarse node is an active
+     * material point with volume dx+^dim) or refined (its r^dim fine nodes
+     * are active, each with volume dx-^dim): every material point is
+     * counted exactly once. Inactive nodes within the horizon of an active
+     * node of their own grid are fictitious: before every force evaluation
+     * the inactive coarse nodes get u from the fine nodes around them
+     * ((3.85)-(3.86); they lie inside refined cells), then the fine
+     * fictitious nodes from the 2^dim coarse nodes of the coarse lattice cell
+     * containing them ((3.87)-(3.88)). Velocity Verlet (3.81)-(3.84) on the
+     * active nodes; the fine grid uses the PMB force with irreversible bond
+     * breaking (2.34), the coarse grid the same standard scheme (adaptive,
+     * standard) or the WLS collocation of the linearized bond-based operator
+     * (3.52)-(3.59) (adaptive, hybrid; coarse nodes whose family is cut by
+     * the body's boundary keep the standard scheme).
+     *
+     * Switching (Fig. 3.30): after each step every bond of an active coarse
+     * node is tested with (3.80), s >= sigma s0; for a critical bond
+     * (x1, x2) all coarse cells whose node lies in H(x1) u H(x2) are
+     * refined: their coarse nodes are deactivated and their fine nodes
+     * activated with u, v, a interpolated from the coarse grid and shifted
+     * so that the cell keeps its mean displacement and momentum. The switch
+     * is one-way. Since coarse bonds never get close to s0 before their
+     * cells are refined, coarse bonds do not break (a coarse bond beyond s0
+     * also counts as critical, the upper bound of (3.80) being for grids
+     * whose bonds break).
+     *
+     * Serial: the whole body is held by the calling process (as the rest
+     * of the multi-grid module).
+     */
+    template <int dim>
+    class MechanicsSolver
+    {
+    public:
+      enum Grid : unsigned int
+      {
+        coarse = 0,
+        fine   = 1
+      };
+
+      explicit MechanicsSolver(const MechanicsParameters<dim> &parameters);
+
+      /** 2D: break the bonds of both grids crossing the segment [a, b]. */
+      void
+      add_precrack(const Point<dim> &a, const Point<dim> &b);
+
+      /** Initial velocity v(x) of every node of both grids. */
+      void
+      set_initial_velocity(const std::function<Tensor<1, dim>(const Point<dim> &)> &v);
+      /** Initial displacement u(x) of every node of both grids (accelerations recomputed). */
+      void
+      set_initial_displacement(const std::function<Tensor<1, dim>(const Point<dim> &)> &u);
+
+      /** Nodes (of either grid) in @p region move with velocity @p v for all times. */
+      void
+      add_prescribed_velocity(const std::function<bool(const Point<dim> &)> &region,
+                              const Tensor<1, dim>                          &v);
+
+      /**
+       * Critical time step: (3.8) for the standard scheme of each grid in
+       * use, and for the WLS stencil the exact limit 2 sqrt(rho / lambda_max)
+       * of its Fourier symbol.
+       */
+      double
+      critical_time_step() const;
+      void
+      set_time_step(const double dt_in)
+      {
+        dt = dt_in;
+      }
+      double
+      time_step() const
+      {
+        return dt;
+      }
+      double
+      time() const
+      {
+        return t;
+      }
+      unsigned int
+      step() const
+      {
+        return n_step;
+      }
+
+      /**
+       * Refine the coarse cells whose node lies in @p region now, as a
+       * switching event does (returns the number of cells refined).
+       */
+      unsigned int
+      refine_region(const std::function<bool(const Point<dim> &)> &region);
+
+      /** One velocity-Verlet step followed by the switching test (adaptive models). */
+      void
+      advance();
+
+      /** @name State and measurements */
+      /** @{ */
+      unsigned int
+      n_nodes(const Grid g) const
+      {
+        return grids[g].n_nodes;
+      }
+      unsigned int
+      n_active(const Grid g) const;
+      unsigned int
+      n_fictitious(const Grid g) const
+      {
+        return fictitious[g].size();
+      }
+      bool
+      is_active(const Grid g, const unsigned int i) const
+      {
+        return active_flag[g][i];
+      }
+      Point<dim>
+      position(const Grid g, const unsigned int i) const;
+      double
+      node_volume(const Grid g) const
+      {
+        return grids[g].volume;
+      }
+      /** Displacement, velocity of node i of grid g (interleaved storage). */
+      Tensor<1, dim>
+      displacement(const Grid g, const unsigned int i) const;
+      Tensor<1, dim>
+      velocity(const Grid g, const unsigned int i) const;
+      Tensor<1, dim>
+      acceleration(const Grid g, const unsigned int i) const;
+      /** True if node i of grid g has its whole bond stencil inside the body. */
+      bool
+      has_full_family(const Grid g, const unsigned int i) const
+      {
+        return grids[g].interior(i);
+      }
+      /** Damage (2.36) of node i of grid g (0 for the coarse grid's unbroken bonds). */
+      double
+      damage(const Grid g, const unsigned int i) const;
+      /** sum rho V over the active nodes. */
+      double
+      active_mass() const;
+      /** sum rho V v over the active nodes. */
+      Tensor<1, dim>
+      momentum() const;
+      /** sum rho V |v|^2 / 2 over the active nodes. */
+      double
+      kinetic_energy() const;
+      /** Number of broken bonds (each counted once). */
+      std::uint64_t
+      n_broken_bonds() const;
+      /** Number of switching events (critical coarse bonds found) so far. */
+      unsigned int
+      n_switches() const
+      {
+        return switches;
+      }
+      /** Wall time spent in forces, interpolation, switching test, switching [s]. */
+      std::array<double, 4> timing{{0., 0., 0., 0.}};
+      double
+      micromodulus() const
+      {
+        return c;
+      }
+      double
+      critical_stretch() const
+      {
+        return s0;
+      }
+      const MechanicsParameters<dim> &
+      parameters() const
+      {
+        return prm;
+      }
+      /** Coarse cells refined so far (indexed by coarse node). */
+      const std::vector<std::uint8_t> &
+      refined_cells() const
+      {
+        return refined;
+      }
+      /**
+       * Total-least-squares angle (degrees, to the x axis, in (-90, 90])
+       * through the active fine nodes with damage >= @p threshold whose
+       * position satisfies @p region and whose distance from @p origin is in
+       * [r_min, r_max] (2D); NaN if fewer than 3. @p n_nodes returns the count.
+       */
+      double
+      crack_angle(const Point<dim>                              &origin,
+                  const std::function<bool(const Point<dim> &)> &region,
+                  const double                                   threshold,
+                  const double                                   r_min,
+                  const double                                   r_max,
+                  unsigned int                                  &n_nodes) const;
+      /** @} */
+
+    private:
+      /** One lattice with its bond stencil. */
+      struct Lattice
+      {
+        double                     dx = 0., volume = 0.;
+        Point<dim>                 origin; ///< first node
+        std::array<int, dim>       n{};
+        unsigned int               n_nodes = 0;
+        std::vector<std::array<int, dim>> offset;
+        std::vector<long>          linear_offset;
+        std::vector<Tensor<1, dim>> xi;
+        std::vector<double>        length;
+        /** c omega beta V / |xi| (PMB force: coef (|y| - |xi|) y / |y|). */
+        std::vector<double>        coefficient;
+        /** beta V (damage). */
+        std::vector<double>        weight;
+        std::vector<unsigned int>  mirror;
+        int                        radius = 0; ///< stencil half width in nodes
+
+        std::array<int, dim>
+        index(const unsigned int i) const;
+        unsigned int
+        node(const std::array<int, dim> &ix) const;
+        bool
+        inside(const std::array<int, dim> &ix) const;
+        Point<dim>
+        point(const unsigned int i) const;
+        /** True if every stencil neighbour of i exists. */
+        bool
+        interior(const unsigned int i) const;
+      };
+
+      MechanicsParameters<dim> prm;
+      unsigned int             ratio;
+      double                   c, s0, dt = 0., t = 0.;
+      unsigned int             n_step = 0, switches = 0;
+      std::array<Lattice, 2>   grids;
+      /** Interleaved u, v, a per grid. */
+      std::array<std::vector<double>, 2> u, v, a;
+      std::array<std::vector<std::uint8_t>, 2> active_flag, broken;
+      /** Prescribed velocity index + 1 per node (0: free). */
+      std::array<std::vector<unsigned int>, 2> prescribed;
+      std::vector<Tensor<1, dim>>             prescribed_velocity;
+      std::vector<std::uint8_t>               refined;
+      std::array<std::vector<unsigned int>, 2> active, fictitious;
+      /** Interior coarse nodes using the WLS stencil (hybrid). */
+      std::vector<std::uint8_t> use_wls;
+      /** The WLS stencil: lattice offset and dim x dim weights (row-major). */
+      std::vector<long>   wls_offset;
+      std::vector<double> wls_weight;
+      /** Stability limit of velocity Verlet with the WLS stencil (its symbol). */
+      double wls_stable_step = 0.;
+      /** Interpolation rows: node, then sources/weights (CSR) for each grid's fictitious list. */
+      std::array<std::vector<unsigned int>, 2> interp_start, interp_source;
+      std::array<std::vector<double>, 2>       interp_weight;
+      /** Coarse nodes to interpolate before the fine fictitious ones (inactive corners too). */
+      std::vector<unsigned int> coarse_interpolated;
+
+      void
+      setup_lattice(const Grid g, const double dx);
+      void
+      setup_wls();
+      /** Rebuild active/fictitious lists and interpolation rows from @p refined. */
+      void
+      update_node_sets();
+      /** IDW / d-linear sources in grid @p from for point @p x. */
+      void
+      interpolation_sources(const Grid                                   from,
+                            const Point<dim>                            &x,
+                            std::vector<std::pair<unsigned int, double>> &out) const;
+      /** u (and optionally v, a) of the fictitious nodes. */
+      void
+      interpolate_fictitious(std::vector<double> *const field[2]);
+      /** a = F / rho on the active nodes. */
+      void
+      compute_accelerations();
+      void
+      standard_forces(const Grid g, const bool allow_breaking);
+      void
+      wls_forces();
+      /** Refine the coarse cells flagged in @p zone; returns how many. */
+      unsigned int
+      refine(const std::vector<std::uint8_t> &zone);
+      /** Coarse cells to refine after the step (3.80); empty result if none. */
+      bool
+      find_critical(std::vector<std::uint8_t> &zone) const;
+      void
+      apply_prescribed();
+    };
+
+    /**
+     * The Kalthoff-Winkler experiment of dissertation Sect. 3.5.1 / paper
+     * 001 Sect. 4.1 on the two-grid solver (units mm, s, tonne, N as in
+     * tutorial/step-4): plate (0, -100)-(100, 100), pre-cracks 50 mm long
+     * from the impacted edge at y = +-25, E = 190e3, nu = 1/4 (plane
+     * strain), rho = 8e-9, G0 = 22.17, v0 = 16.5e3 held on the fine nodes
+     * of the first column (x < dx-) between the pre-cracks, T = 87.5e-6.
+     * The initial fine region (adaptive models) is every coarse cell whose
+     * node lies within delta of the plate's boundary or of a pre-crack
+     * (paper 001, Fig. 7: "the pre-cracks and the boundaries").
+     */
+    struct KalthoffWinkler
+    {
+      MechanicsModel model     = MechanicsModel::adaptive_hybrid;
+      double         coarse_dx = 2., fine_dx = 1., delta = 8.;
+      double         end_time  = 87.5e-6;
+      Interpolation  interpolation = Interpolation::inverse_distance;
+
+      MechanicsParameters<2>
+      parameters() const;
+      /** Pre-cracks and the impact velocity. */
+      void
+      load(MechanicsSolver<2> &solver) const;
+      /** Number of steps: 0.9 x the critical step, rounded to end on end_time. */
+      unsigned int
+      n_steps(const MechanicsSolver<2> &solver) const;
+      /**
+       * Angle of the upper crack (tutorial/step-4's measurement): damaged
+       * (>= 0.35) fine nodes up and to the right of the tip (50, 25), at
+       * delta to 50 mm from it.
+       */
+      double
+      crack_angle(const MechanicsSolver<2> &solver, unsigned int &n_nodes) const;
+      /** Largest distance of a damaged (>= 0.35) fine node of that region from the tip. */
+      double
+      crack_length(const MechanicsSolver<2> &solver) const;
+
+      /** What run() measures. */
+      struct Result
+      {
+        unsigned int coarse_begin = 0, fine_begin = 0, coarse_end = 0, fine_end = 0;
+        unsigned int steps = 0, switches = 0, crack_nodes = 0;
+        double       angle = 0., length = 0.;
+        /** Wall time of the time loop (setup excluded) [s]. */
+        double seconds = 0.;
+        /** MechanicsSolver::timing: forces, interpolation, switching test, switching. */
+        std::array<double, 4> timing{{0., 0., 0., 0.}};
+      };
+      /**
+       * Set up, load and run to end_time; @p monitor (if set) is called
+       * after setup and every @p interval steps and at the end (not timed).
+       */
+      Result
+      run(const std::function<void(const MechanicsSolver<2> &)> &monitor  = {},
+          const unsigned int                                     interval = 0) const;
+    };
+  } // namespace MultiGrid
+} // namespace PeriDEAL
+
+#endif

@@ -1,0 +1,433 @@
+// Tests of the two-grid explicit mechanics and the multi-adaptive scheme
+// (MultiGrid::MechanicsSolver, dissertation Sect. 3.4-3.5, paper 001):
+// patch tests (constant and linear fields), mass counted once, momentum,
+// a 1D elastic wave against the uniform fine grid, and the CI-size
+// Kalthoff-Winkler experiment with the three models.
+
+#include <perideal/base/exceptions.h>
+#include <perideal/multigrid/multigrid_mechanics.h>
+
+#include "../check.h"
+
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEAL::MultiGrid;
+using namespace PeriDEALTests;
+
+namespace
+{
+  template <int dim>
+  using Solver = MechanicsSolver<dim>;
+
+  // Largest |a| over the active nodes of both grids, split into nodes with
+  // and without a complete family.
+  template <int dim>
+  std::pair<double, double>
+  max_acceleration(const Solver<dim> &s)
+  {
+    double interior = 0., boundary = 0.;
+    for (const auto g : {Solver<dim>::coarse, Solver<dim>::fine})
+      for (unsigned int i = 0; i < s.n_nodes(g); ++i)
+        if (s.is_active(g, i))
+          {
+            const double a = s.acceleration(g, i).norm();
+            (s.has_full_family(g, i) ? interior : boundary) =
+              std::max(s.has_full_family(g, i) ? interior : boundary, a);
+          }
+    return {interior, boundary};
+  }
+
+  MechanicsParameters<2>
+  plate(const MechanicsModel model, const Interpolation interpolation)
+  {
+    MechanicsParameters<2> p;
+    p.lower         = Point<2>(0., 0.);
+    p.upper         = Point<2>(48., 40.);
+    p.coarse_dx     = 2.;
+    p.fine_dx       = 1.;
+    p.delta         = 8.;
+    p.model         = model;
+    p.interpolation = interpolation;
+    p.initial_fine_region = [](const Point<2> &x) {
+      return x[0] > 14. && x[0] < 30. && x[1] > 12. && x[1] < 26.;
+    };
+    return p;
+  }
+
+  // Patch tests: a rigid translation gives zero force on every node with
+  // both interpolations (they reproduce constants); an affine field gives
+  // zero force on every node with a complete family when the interpolation
+  // is d-linear (exact for linear fields) and the coarse grid uses the
+  // standard scheme (symmetric stencil) or WLS (complete to order 2).
+  // Inverse-distance weighting is not linear-exact: its interface force is
+  // reported.
+  void
+  patch()
+  {
+    for (const auto model : {MechanicsModel::adaptive_standard, MechanicsModel::adaptive_hybrid})
+      for (const auto interp : {Interpolation::multilinear, Interpolation::inverse_distance})
+        {
+          const std::string name = to_string(model) + (interp == Interpolation::multilinear ?
+                                                         ", d-linear" : ", IDW");
+          Solver<2> s(plate(model, interp));
+          check(s.n_active(Solver<2>::fine) > 0 && s.n_fictitious(Solver<2>::fine) > 0 &&
+                  s.n_fictitious(Solver<2>::coarse) > 0,
+                name + ": both grids have active and fictitious nodes");
+          s.set_initial_displacement([](const Point<2> &) { return Tensor<1, 2>({0.3, -0.2}); });
+          const double eps = 1e-3;
+          const auto   t   = max_acceleration(s);
+          s.set_initial_displacement([&](const Point<2> &x) {
+            return Tensor<1, 2>({eps * (x[0] + 0.5 * x[1]), eps * (-0.3 * x[0] + 2. * x[1])});
+          });
+          const auto l = max_acceleration(s);
+          // Scale: the force on the boundary nodes of the affine field.
+          check(l.second > 0., name + ": boundary nodes feel the affine field");
+          check(std::max(t.first, t.second) <= 1e-12 * l.second,
+                name + ": translation, max |a| = " + sci(std::max(t.first, t.second)) +
+                  " <= 1e-12 x " + sci(l.second));
+          if (interp == Interpolation::multilinear)
+            check(l.first <= 1e-10 * l.second,
+                  name + ": affine field, interior max |a| = " + sci(l.first) + " <= 1e-10 x " +
+                    sci(l.second));
+          else
+            std::cout << "  info  " << name << ": affine field, interior max |a| = " << sci(l.first)
+                      << " (boundary " << sci(l.second) << ")" << std::endl;
+        }
+  }
+
+  // Sum rho V |v| over the active nodes: the scale of the momentum.
+  template <int dim>
+  double
+  momentum_scale(const Solver<dim> &s)
+  {
+    double sum = 0.;
+    for (const auto g : {Solver<dim>::coarse, Solver<dim>::fine})
+      for (unsigned int i = 0; i < s.n_nodes(g); ++i)
+        if (s.is_active(g, i))
+          sum += s.parameters().density * s.node_volume(g) * s.velocity(g, i).norm();
+    return sum;
+  }
+
+  // Mass is counted once: active coarse and fine volumes add up to the
+  // plate's area before and after switching. A switch keeps each refined
+  // cell's momentum. Momentum of a free plate with switching.
+  void
+  mass_momentum()
+  {
+    const double area = 48. * 40.;
+    for (const auto model : {MechanicsModel::uniform_fine, MechanicsModel::adaptive_standard,
+                             MechanicsModel::adaptive_hybrid})
+      {
+        auto p             = plate(model, Interpolation::inverse_distance);
+        p.critical_stretch = 4e-3;
+        Solver<2> s(p);
+        check_close(s.active_mass(), area, 1e-14, to_string(model) + ": active mass at t = 0");
+        // A bump of largest gradient 0.107 x 0.04 = 4.3e-3 around (40, 20)
+        // in the coarse region, its tail across the interface x = 30:
+        // bonds reach sigma s0 = 3.8e-3 in the first steps.
+        s.set_initial_displacement([](const Point<2> &x) {
+          const double r2 = (x - Point<2>(40., 20.)).norm_square();
+          return Tensor<1, 2>({0.04 * std::exp(-r2 / 64.), 0.});
+        });
+        const unsigned int fine0 = s.n_active(Solver<2>::fine);
+        double             scale = 0.;
+        for (unsigned int n = 0; n < 40; ++n)
+          {
+            s.advance();
+            scale = std::max(scale, momentum_scale(s));
+          }
+        check_close(s.active_mass(), area, 1e-14, to_string(model) + ": active mass after " +
+                                                    std::to_string(s.n_switches()) + " switches");
+        const double P = s.momentum().norm() / scale;
+        if (model == MechanicsModel::uniform_fine)
+          // Full list, every pair with one coefficient: f_ij = -f_ji.
+          check(P < 1e-12, "uniform fine: |P| / sum rho V |v| = " + sci(P) + " < 1e-12");
+        else
+          {
+            check(s.n_switches() > 0 && s.n_active(Solver<2>::fine) > fine0,
+                  to_string(model) + ": fine region grew (" + std::to_string(fine0) + " -> " +
+                    std::to_string(s.n_active(Solver<2>::fine)) + ")");
+            // A switch itself keeps the momentum (next check); the forces
+            // of the coupling (3.81)-(3.88) are not pairwise (a coarse
+            // node's bond to a fictitious node has no reaction on the fine
+            // nodes that define it), so momentum is conserved only up to the
+            // interface error of a field that varies on the scale of delta.
+            // Measured 7.9e-3 (standard) and 8.1e-3 (hybrid) with IDW,
+            // 3.9e-3 and 4.4e-3 with d-linear. Bound: 2 %.
+            check(P < 2e-2, to_string(model) + ": |P| / sum rho V |v| = " + sci(P) + " < 2e-2");
+
+            // Refining a band now: mass and momentum unchanged to round-off.
+            const auto   P0 = s.momentum();
+            const auto   n  = s.refine_region([](const Point<2> &x) { return x[1] < 10.; });
+            check(n > 0, to_string(model) + ": " + std::to_string(n) + " cells refined on request");
+            check((s.momentum() - P0).norm() <= 1e-13 * scale,
+                  to_string(model) + ": a switch keeps the momentum (|dP| = " +
+                    sci((s.momentum() - P0).norm()) + ")");
+            check_close(s.active_mass(), area, 1e-14, to_string(model) + ": mass after it");
+          }
+      }
+  }
+
+  // 1D elastic wave: a Gaussian pulse u0 = A exp(-(x - 70)^2 / w^2),
+  // w = 8 = 4 delta, v0 = -c0 u0' (c0 = sqrt(E / rho) = 1), crossing a fine
+  // region. Reference: the continuum linear PD solution by Fourier
+  // transform, u(s, t) = 1/pi int_0^inf U(k) [cos(w t) cos(k s) +
+  // c0 k / w sin(w t) sin(k s)] dk, U = A w sqrt(pi) exp(-k^2 w^2 / 4),
+  // rho w(k)^2 = 2 c int_0^delta (1 - cos k xi) / xi dxi (the dispersion
+  // relation of the 1D bond-based model, c = 2E / delta^2).
+  void
+  wave()
+  {
+    const double A = 1e-3, w = 8., x0 = 70., T = 60., delta = 2.;
+    const double c = 2. / (delta * delta);
+    // Simpson's rule on [a, b] with n (even) intervals.
+    const auto simpson = [](const auto &f, const double a, const double b, const unsigned int n) {
+      const double h = (b - a) / n;
+      double       s = f(a) + f(b);
+      for (unsigned int i = 1; i < n; ++i)
+        s += (i % 2 ? 4. : 2.) * f(a + i * h);
+      return s * h / 3.;
+    };
+    const unsigned int  nk = 4000;
+    const double        kmax = 12. / w;
+    std::vector<double> omega(nk + 1);
+    for (unsigned int q = 0; q <= nk; ++q)
+      {
+        const double k = q * kmax / nk;
+        omega[q]       = std::sqrt(2. * c * simpson([k](const double xi) {
+                                 return xi > 0. ? (1. - std::cos(k * xi)) / xi : 0.;
+                               }, 0., delta, 400));
+      }
+    const auto reference = [&](const double x) {
+      const double sx = x - x0;
+      return simpson([&](const double k) {
+        const unsigned int q  = static_cast<unsigned int>(std::round(k / kmax * nk));
+        const double       U  = A * w * std::sqrt(M_PI) * std::exp(-k * k * w * w / 4.);
+        const double       om = omega[q];
+        const double       sn = om > 0. ? k / om * std::sin(om * T) : T;
+        return U * (std::cos(om * T) * std::cos(k * sx) + sn * std::sin(k * sx)) / M_PI;
+      }, 0., kmax, nk);
+    };
+    // The local limit (classical wave, d'Alembert): what the order-2 WLS
+    // operator of the hybrid's coarse grid converges to (exact for
+    // quadratics, it drops the delta^4 u'''' dispersion of (3.70)).
+    double e_local = 0.;
+    for (double x = 60.; x < 200.; x += 0.25)
+      e_local = std::max(e_local, std::abs(A * std::exp(-(x - x0 - T) * (x - x0 - T) / (w * w)) -
+                                           reference(x)) / A);
+    std::cout << "  info  local wave vs PD: max |u_local - u_PD| / A = " << sci(e_local) << std::endl;
+    std::map<MechanicsModel, double> error, drift;
+    for (const auto model : {MechanicsModel::uniform_fine, MechanicsModel::uniform_coarse,
+                             MechanicsModel::adaptive_standard, MechanicsModel::adaptive_hybrid})
+      {
+        MechanicsParameters<1> p;
+        p.lower[0]      = 0.;
+        p.upper[0]      = 240.;
+        p.coarse_dx     = 0.5;
+        p.fine_dx       = 0.25;
+        p.delta         = delta;
+        p.model         = model;
+        p.n_collocation = 0;
+        p.initial_fine_region = [](const Point<1> &x) { return x[0] > 100. && x[0] < 140.; };
+        Solver<1>  s(p);
+        const auto g = [&](const double x) { return A * std::exp(-(x - x0) * (x - x0) / (w * w)); };
+        s.set_initial_displacement([&](const Point<1> &x) { return Tensor<1, 1>({g(x[0])}); });
+        s.set_initial_velocity([&](const Point<1> &x) {
+          return Tensor<1, 1>({2. * (x[0] - x0) / (w * w) * g(x[0])});
+        });
+        const auto n = static_cast<unsigned int>(std::ceil(T / s.time_step()));
+        s.set_time_step(T / n);
+        const double P0 = s.momentum()[0], scale = momentum_scale(s);
+        for (unsigned int k = 0; k < n; ++k)
+          s.advance();
+        drift[model] = std::abs(s.momentum()[0] - P0) / scale;
+        double e     = 0.;
+        for (const auto gr : {Solver<1>::coarse, Solver<1>::fine})
+          for (unsigned int i = 0; i < s.n_nodes(gr); ++i)
+            if (s.is_active(gr, i))
+              {
+                const double x = s.position(gr, i)[0];
+                // The interval the pulse covers at T (the reference ignores the ends).
+                if (x > 60. && x < 200.)
+                  e = std::max(e, std::abs(s.displacement(gr, i)[0] - reference(x)));
+              }
+        error[model] = e / A;
+        std::cout << "  info  " << to_string(model) << ": max |u - u_PD| / A = " << sci(e / A)
+                  << ", |P(T) - P(0)| / sum rho V |v| = " << sci(drift[model]) << std::endl;
+      }
+    const double e_fine = error[MechanicsModel::uniform_fine],
+                 e_coarse = error[MechanicsModel::uniform_coarse];
+    // Standard scheme: quadrature error of m = 8 below that of m = 4, both
+    // a modulus error of a few 1e-3 (1.1e-2 A ~ 30 eps max|g'| / A).
+    check(e_fine < e_coarse && e_coarse < 2e-2,
+          "uniform fine " + sci(e_fine) + " < uniform coarse " + sci(e_coarse) + " < 2e-2");
+    check(drift[MechanicsModel::uniform_fine] < 1e-10 && drift[MechanicsModel::uniform_coarse] < 1e-10,
+          "uniform grids conserve momentum to round-off");
+    for (const auto m : {MechanicsModel::adaptive_standard, MechanicsModel::adaptive_hybrid})
+      {
+        // The pulse crosses the fine region: the multi-grid error may not
+        // exceed the all-coarse one by more than 25 % (interface reflection
+        // and interpolation).
+        // The hybrid's coarse grid solves the local limit: its bound adds
+        // the local-vs-PD difference.
+        const double bound =
+          1.25 * e_coarse + (m == MechanicsModel::adaptive_hybrid ? e_local : 0.);
+        check(error[m] <= bound, to_string(m) + ": error " + sci(error[m]) + " <= " + sci(bound));
+        // Momentum: the coupling is not pairwise (see mass_momentum);
+        // measured 8.6e-4 (standard), 2.7e-4 (hybrid). Bound 2e-3.
+        check(drift[m] < 2e-3, to_string(m) + ": momentum drift " + sci(drift[m]) + " < 2e-3");
+      }
+  }
+
+  // Kalthoff-Winkler at CI size (delta = 8, dx+ = 2, dx- = 1; m+ = 4 is
+  // the smallest horizon with the 49 collocation nodes of n_c = 49). The
+  // reference is the uniform fine grid. At this horizon (8 % of the plate
+  // width) the crack angle is 58.6 degrees, not the 68 of the experiment;
+  // tutorial/step-11 compares with 68 at delta = 4.
+  void
+  kw()
+  {
+    struct Final
+    {
+      KalthoffWinkler::Result   r;
+      std::vector<std::uint8_t> refined0, refined1;
+      std::vector<double>       damage;
+      double                    mass = 0.;
+    };
+    std::map<MechanicsModel, Final> res;
+    for (const auto model : {MechanicsModel::uniform_fine, MechanicsModel::adaptive_standard,
+                             MechanicsModel::adaptive_hybrid})
+      {
+        KalthoffWinkler kwp;
+        kwp.model = model;
+        Final &f  = res[model];
+        f.r       = kwp.run([&](const Solver<2> &s) {
+          if (s.step() == 0)
+            {
+              f.refined0 = s.refined_cells();
+              return;
+            }
+          f.refined1 = s.refined_cells();
+          f.mass     = s.active_mass();
+          f.damage.clear();
+          for (unsigned int i = 0; i < s.n_nodes(Solver<2>::fine); ++i)
+            f.damage.push_back(s.is_active(Solver<2>::fine, i) ? s.damage(Solver<2>::fine, i) : 0.);
+        });
+        const auto &r = f.r;
+        std::cout << "  info  " << to_string(model) << ": " << r.steps << " steps, angle " << r.angle
+                  << " (" << r.crack_nodes << " nodes), length " << r.length << ", active coarse "
+                  << r.coarse_begin << " -> " << r.coarse_end << ", fine " << r.fine_begin << " -> "
+                  << r.fine_end << ", " << r.switches << " switches, " << r.seconds << " s" << std::endl;
+        check_close(f.mass, 8e-9 * 100. * 200., 1e-13,
+                    to_string(model) + ": active mass = plate mass at the end");
+      }
+    const auto &ref = res[MechanicsModel::uniform_fine];
+    check(ref.r.crack_nodes > 100, "uniform fine: a crack grew (" +
+                                     std::to_string(ref.r.crack_nodes) + " crack nodes)");
+    for (const auto model : {MechanicsModel::adaptive_standard, MechanicsModel::adaptive_hybrid})
+      {
+        const auto       &f    = res[model];
+        const std::string name = to_string(model);
+        // 3 degrees: about a third of the 68 +- 8 band of step-4; measured
+        // 0.004 (standard) and 0.61 (hybrid).
+        check(std::abs(f.r.angle - ref.r.angle) < 3., name + ": crack angle " +
+                                                        std::to_string(f.r.angle) +
+                                                        " within 3 deg of uniform fine");
+        // Tip position: within 2 dx+ (catalog P1 item 10).
+        check(std::abs(f.r.length - ref.r.length) <= 2. * 2.,
+              name + ": crack length " + std::to_string(f.r.length) + " vs " +
+                std::to_string(ref.r.length) + " within 2 dx+");
+        // Damage maps: fine nodes whose damage differs by > 0.2, fewer than
+        // 10 % of the reference's damaged nodes (measured 0.1-0.5 %).
+        unsigned int differ = 0, damaged = 0;
+        for (unsigned int i = 0; i < f.damage.size(); ++i)
+          {
+            damaged += ref.damage[i] > 0.2;
+            differ += std::abs(f.damage[i] - ref.damage[i]) > 0.2;
+          }
+        check(differ < 0.1 * damaged, name + ": damage differs by > 0.2 at " +
+                                        std::to_string(differ) + " of " + std::to_string(damaged) +
+                                        " damaged nodes (< 10 %)");
+        check(f.r.fine_end > f.r.fine_begin && f.r.coarse_end < f.r.coarse_begin,
+              name + ": Omega- grew");
+        // Growth along the cracks only: every newly refined cell lies within
+        // 2 delta + dx+ of a node damaged in the reference (the switching
+        // zone is H(x1) u H(x2) of a critical bond next to the crack).
+        unsigned int new_cells = 0, far = 0;
+        const double dmax = 2. * 8. + 2.;
+        for (unsigned int c = 0; c < f.refined1.size(); ++c)
+          if (f.refined1[c] && !f.refined0[c])
+            {
+              ++new_cells;
+              const Point<2> xc(1. + 2. * (c % 50), -99. + 2. * (c / 50));
+              bool           near = false;
+              for (unsigned int i = 0; i < ref.damage.size() && !near; ++i)
+                if (ref.damage[i] > 0.35)
+                  near = xc.distance(Point<2>(0.5 + (i % 100), -99.5 + (i / 100))) <= dmax;
+              far += !near;
+            }
+        check(new_cells > 0 && far == 0, name + ": " + std::to_string(new_cells) +
+                                           " cells refined, " + std::to_string(far) +
+                                           " farther than 2 delta + dx+ from the cracks");
+      }
+  }
+
+  void
+  bad_input()
+  {
+    auto p      = plate(MechanicsModel::adaptive_hybrid, Interpolation::inverse_distance);
+    bool thrown = false;
+    try
+      {
+        p.fine_dx = 0.8;
+        Solver<2> s(p);
+      }
+    catch (const ParameterError &e)
+      {
+        thrown = e.parameter == "Fine grid spacing";
+      }
+    check(thrown, "dx+/dx- not an integer throws ParameterError 'Fine grid spacing'");
+    thrown = false;
+    try
+      {
+        parse_mechanics_model("adaptive fancy");
+      }
+    catch (const ParameterError &e)
+      {
+        thrown = e.parameter == "Model";
+      }
+    check(thrown, "an unknown model throws ParameterError 'Model'");
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const std::string                what = argc > 1 ? argv[1] : "";
+  try
+    {
+      if (what == "patch")
+        patch();
+      else if (what == "mass_momentum")
+        mass_momentum();
+      else if (what == "wave")
+        wave();
+      else if (what == "kw")
+        kw();
+      else if (what == "bad_input")
+        bad_input();
+      else
+        {
+          std::cerr << "usage: multiadapt_tests patch|mass_momentum|wave|kw|bad_input" << std::endl;
+          return 2;
+        }
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "exception: " << e.what() << std::endl;
+      return 1;
+    }
+  return failures() == 0 ? 0 : 1;
+}

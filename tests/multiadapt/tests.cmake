@@ -1,0 +1,10 @@
+# Two-grid explicit mechanics and the multi-adaptive scheme
+# (MultiGrid::MechanicsSolver): patch tests, mass and momentum, a 1D wave
+# against the uniform fine grid, the CI-size Kalthoff-Winkler experiment.
+perideal_add_test_program(multiadapt_tests ${CMAKE_CURRENT_LIST_DIR}/multiadapt_tests.cc)
+foreach(_t patch mass_momentum wave kw bad_input)
+  perideal_add_test(NAME multiadapt.${_t} COMMAND $<TARGET_FILE:multiadapt_tests> ${_t} LABELS unit)
+endforeach()
+# tutorial/step-11 (multi-adaptive Kalthoff-Winkler) with a reduced parameter file.
+perideal_add_test(NAME tutorial.step-11 COMMAND $<TARGET_FILE:step-11>
+  ${CMAKE_CURRENT_LIST_DIR}/step-11-ci.prm LABELS "tutorial" TIMEOUT 600)
