@@ -1,0 +1,11 @@
+perideal_add_test_program(elastic_abc_tests ${CMAKE_CURRENT_LIST_DIR}/elastic_abc_tests.cc)
+
+foreach(_t dispersion guards)
+  perideal_add_test(NAME elastic_abc.${_t} COMMAND $<TARGET_FILE:elastic_abc_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME elastic_abc.unbounded COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded
+  LABELS convergence)
+perideal_add_test(NAME elastic_abc.ranks.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:elastic_abc_tests> ranks LABELS mpi)
+perideal_add_test(NAME elastic_abc.unbounded_long COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded_long
+  LABELS long TIMEOUT 3000)
