@@ -263,7 +263,8 @@ namespace
     Timer        timer;
     const auto   prm    = abc_parameters();
     const double cp     = std::sqrt(9. / 8.);
-    const double radius = reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta);
+    // Rounded to whole dx so that both lattices coincide.
+    const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta) / c.dx) * c.dx;
     if (std::getenv("EL_ONLY_ABC"))
       {
         // Exploration: the energy of the ABC run alone.
@@ -297,7 +298,8 @@ namespace
     const double e_abc = energy_error(abc, ref, last), e_free = energy_error(free, ref, last),
                  e_fixed = energy_error(fixed, ref, last);
     // (b) the energy left in the compared disc at T.
-    check(e_abc < 0.02, "ABC: |Pi - Pi_ref|/Pi_ref(0) at T = " + sci(e_abc) + " < 2e-2");
+    // Measured 7.6e-4 (free 3.8e-2, fixed 1.2e-1); asserted with a 2.5x margin.
+    check(e_abc < 2e-3, "ABC: |Pi - Pi_ref|/Pi_ref(0) at T = " + sci(e_abc) + " < 2e-3");
     check(10. * e_abc < e_free, "ABC at least 10x closer than the free truncation: " + sci(e_abc) + " vs " + sci(e_free));
     check(10. * e_abc < e_fixed, "ABC at least 10x closer than the fixed truncation: " + sci(e_abc) + " vs " + sci(e_fixed));
     // (c) the total energy of the truncated domain never increases between

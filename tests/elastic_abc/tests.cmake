@@ -9,3 +9,6 @@ perideal_add_test(NAME elastic_abc.ranks.np2 NPROCS 2
   COMMAND $<TARGET_FILE:elastic_abc_tests> ranks LABELS mpi)
 perideal_add_test(NAME elastic_abc.unbounded_long COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded_long
   LABELS long TIMEOUT 3000)
+# step-8 with a reduced near field (disc radius 12, half-space 40 x 20).
+perideal_add_test(NAME elastic_abc.tutorial.step-8 COMMAND $<TARGET_FILE:step-8> ${CMAKE_CURRENT_LIST_DIR}/step-8-ci.prm
+  LABELS tutorial)
