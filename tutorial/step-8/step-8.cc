@@ -151,10 +151,11 @@ namespace Step8
 
   void
   write_energies(const std::string &file, const std::vector<std::string> &names,
-                 const std::vector<const ElasticRunHistory *> &runs)
+                 const std::vector<const ElasticRunHistory *> &runs, const bool by_final)
   {
     std::ofstream out(file);
-    const double  e0 = runs[0]->energy(0);
+    // Normalized by the reference energy at t = 0 (pulse) or at t_end (impact).
+    const double e0 = runs[0]->energy(by_final ? runs[0]->times.size() - 1 : 0);
     out << "t";
     for (const auto &n : names)
       out << ',' << n << " kinetic," << n << " strain," << n << " total";
@@ -169,13 +170,15 @@ namespace Step8
   }
 
   void
-  plot(const std::string &dir, const std::string &name, const std::string &title, const unsigned int n_runs)
+  plot(const std::string &dir, const std::string &name, const std::string &title, const unsigned int n_runs,
+       const bool log_scale)
   {
     std::ostringstream gp;
     gp << gnuplot_png_preamble(dir + "/" + name + ".png")
        << "set datafile separator ','\nset key autotitle columnhead top right\n"
-       << "set logscale y\nset yrange [1e-4:2]\nset xlabel 't'\nset title '" << title << "'\n"
-       << "set ylabel 'Pi/Pi_ref(0) (compared region)'\n"
+       << (log_scale ? "set logscale y\nset yrange [1e-4:2]\nset ylabel 'Pi/Pi_ref(0) (compared region)'\n" :
+                       "set ylabel 'Pi/Pi_ref(t_end) (compared region)'\n")
+       << "set xlabel 't'\nset title '" << title << "'\n"
        << "plot for [i=0:" << n_runs - 1 << "] '" << dir << "/" << name
        << ".csv' using 1:(column(4+3*i)) with linespoints lw 2 title columnhead(4+3*i), "
        << "for [i=0:" << n_runs - 1 << "] '' using 1:(column(2+3*i)) with lines dt 2 title columnhead(2+3*i)\n";
@@ -215,8 +218,8 @@ namespace Step8
         std::cout << "Part 1 (radial pulse): reference " << ref.n_nodes << " nodes (radius " << r_ref
                   << ")\n  ABC: " << statistics(abc) << std::endl;
         write_energies(p.output_directory + "/energy_pulse.csv", {"reference", "ABC", "free", "fixed"},
-                       {&ref, &abc, &fr, &fx});
-        plot(p.output_directory, "energy_pulse", "radial pulse: total (solid) and kinetic (dashed)", 4);
+                       {&ref, &abc, &fr, &fx}, false);
+        plot(p.output_directory, "energy_pulse", "radial pulse: total (solid) and kinetic (dashed)", 4, true);
       }
     const unsigned int last = p.n_samples;
     const auto err = [&](const ElasticRunHistory &h) { return std::abs(h.energy(last) - ref.energy(last)) / ref.energy(0); };
@@ -310,8 +313,8 @@ namespace Step8
                     << r->tip_depth[0] << " / " << r->tip_depth[1] << ", |Pi - Pi_ref|/Pi_ref at t_end "
                     << sci(err(*r)) << std::endl;
         write_energies(p.output_directory + "/energy_fracture.csv", {"reference", "ABC", "free"},
-                       {&ref.history, &abc.history, &fr.history});
-        plot(p.output_directory, "energy_fracture", "notched half-space: total (solid) and kinetic (dashed)", 3);
+                       {&ref.history, &abc.history, &fr.history}, true);
+        plot(p.output_directory, "energy_fracture", "notched half-space: total (solid) and kinetic (dashed)", 3, false);
       }
     check(err(abc) < err(fr), "half-space: the ABC energy is closer to the reference than the free truncation's");
     const double tip_abc = std::abs(abc.tip_depth[0] - ref.tip_depth[0]) + std::abs(abc.tip_depth[1] - ref.tip_depth[1]);
