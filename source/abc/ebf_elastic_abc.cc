@@ -3,6 +3,8 @@
 #include <perideal/abc/ebf_elastic_abc.h>
 #include <perideal/base/exceptions.h>
 
+#include <deal.II/lac/lapack_full_matrix.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -542,6 +544,85 @@ namespace PeriDEAL
       const auto end = clock::now();
       abc_seconds += std::chrono::duration<double>(abc_end - start + end - set_start).count();
       step_seconds += std::chrono::duration<double>(end - start).count();
+    }
+
+    double
+    PdUnboundedElastic::one_step_spectral_radius(const unsigned int max_size, unsigned int *n_unstable)
+    {
+      const MPI_Comm comm = disc.get_mpi_communicator();
+      check_parameter(Utilities::MPI::n_mpi_processes(comm) == 1, "MPI ranks",
+                      Utilities::MPI::n_mpi_processes(comm),
+                      "1 (the spectral radius check assembles the dense one-step map)");
+      check_parameter(op->is_linearized(), "Model/Linearized", "false",
+                      "true (the one-step map must be linear)");
+      const unsigned int               n = disc.n_owned();
+      const std::vector<unsigned int> &c = abc.cloud_points();
+      const unsigned int               nc = truncation == ElasticTruncation::absorbing ? c.size() : 0;
+      const unsigned int               m  = 4 * n + 4 * nc;
+      check_parameter(m <= max_size, "State size of the spectral radius check", m,
+                      "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
+      // Entry of component q: u at q n + i, v at (2 + q) n + i, u_old at
+      // 4 n + q nc + k, v_old at 4 n + (2 + q) nc + k.
+      const VectorField                        u0 = u, v0 = v, a0 = a;
+      const std::array<std::vector<double>, 2> uo0 = u_old, vo0 = v_old;
+      const double                             t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      LAPACKFullMatrix<double>                 map(m, m);
+      for (unsigned int col = 0; col < m; ++col)
+        {
+          for (unsigned int q = 0; q < 2; ++q)
+            {
+              for (unsigned int i = 0; i < n; ++i)
+                {
+                  u[q].local_element(i) = (col == q * n + i) ? 1. : 0.;
+                  v[q].local_element(i) = (col == (2 + q) * n + i) ? 1. : 0.;
+                }
+              for (unsigned int k = 0; k < nc; ++k)
+                {
+                  u_old[q][c[k]] = (col == 4 * n + q * nc + k) ? 1. : 0.;
+                  v_old[q][c[k]] = (col == 4 * n + (2 + q) * nc + k) ? 1. : 0.;
+                }
+            }
+          compute_acceleration();
+          advance();
+          for (unsigned int q = 0; q < 2; ++q)
+            {
+              for (unsigned int i = 0; i < n; ++i)
+                {
+                  map(q * n + i, col)       = u[q].local_element(i);
+                  map((2 + q) * n + i, col) = v[q].local_element(i);
+                }
+              for (unsigned int k = 0; k < nc; ++k)
+                {
+                  map(4 * n + q * nc + k, col)       = u_old[q][c[k]];
+                  map(4 * n + (2 + q) * nc + k, col) = v_old[q][c[k]];
+                }
+            }
+        }
+      u     = u0;
+      v     = v0;
+      a     = a0;
+      u_old = uo0;
+      v_old = vo0;
+      for (unsigned int q = 0; q < 2; ++q)
+        {
+          u[q].update_ghost_values();
+          v[q].update_ghost_values();
+        }
+      t            = t0;
+      abc_seconds  = abc0;
+      step_seconds = step0;
+      map.compute_eigenvalues(false, false);
+      double       rho_max = 0.;
+      unsigned int n_up    = 0;
+      for (unsigned int i = 0; i < m; ++i)
+        {
+          const double mod = std::abs(map.eigenvalue(i));
+          rho_max          = std::max(rho_max, mod);
+          n_up += mod > 1. + 1e-8 ? 1 : 0;
+        }
+      if (n_unstable)
+        *n_unstable = n_up;
+      return rho_max;
     }
 
     std::array<double, 2>

@@ -213,6 +213,20 @@ namespace PeriDEAL
       void
       advance();
 
+      /**
+       * Spectral radius of the linear one-step map of the whole truncated
+       * system (linearized model, serial, at most @p max_size state
+       * entries, else ParameterError): the state (u, v of all nodes,
+       * u^{n-1}, v^{n-1} of the cloud points) is mapped column by column
+       * through advance() and the eigenvalues of the dense matrix are
+       * computed by LAPACK; the solver state is restored. The number of
+       * eigenvalues of modulus > 1 + 1e-8 goes to @p n_unstable if given.
+       * A diagnostic of the coupled near-field/ABC recursion, which the
+       * per-cloud guards do not control (doc/design.md).
+       */
+      double
+      one_step_spectral_radius(const unsigned int max_size = 4000, unsigned int *n_unstable = nullptr);
+
       /** Kinetic and strain energy (4.169) of the nodes with inside(x) (all ranks). */
       std::array<double, 2>
       energy(const std::function<bool(const Point<2> &)> &inside) const;
