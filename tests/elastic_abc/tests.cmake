@@ -1,0 +1,17 @@
+perideal_add_test_program(elastic_abc_tests ${CMAKE_CURRENT_LIST_DIR}/elastic_abc_tests.cc)
+
+foreach(_t dispersion guards)
+  perideal_add_test(NAME elastic_abc.${_t} COMMAND $<TARGET_FILE:elastic_abc_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME elastic_abc.unbounded COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded
+  LABELS convergence)
+perideal_add_test(NAME elastic_abc.ranks.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:elastic_abc_tests> ranks LABELS mpi)
+perideal_add_test(NAME elastic_abc.unbounded_long COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded_long
+  LABELS long TIMEOUT 3000)
+# step-8 with a reduced near field (disc radius 12, half-space 40 x 20).
+perideal_add_test(NAME elastic_abc.tutorial.step-8 COMMAND $<TARGET_FILE:step-8> ${CMAKE_CURRENT_LIST_DIR}/step-8-ci.prm
+  LABELS tutorial)
+# Dense one-step map (about 4,000 x 4,000): ~40 s, so long.
+perideal_add_test(NAME elastic_abc.spectral_radius COMMAND $<TARGET_FILE:elastic_abc_tests> spectral_radius
+  LABELS long TIMEOUT 600)
