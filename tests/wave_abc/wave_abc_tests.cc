@@ -616,7 +616,8 @@ namespace
   double
   radius_2d(const double R, const WaveAbcParameters &prm, const double dx = 0.25,
             const double m = 6, unsigned int *n_up = nullptr, WaveCloudStatistics *stats = nullptr,
-            std::complex<double> *dominant = nullptr)
+            std::complex<double> *dominant = nullptr, WaveSpectralDiagnostics *diag = nullptr,
+            std::vector<Point<2>> *positions = nullptr)
   {
     LatticeParameters lp;
     lp.dx    = dx;
@@ -631,6 +632,18 @@ namespace
     pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, std::getenv("WAVE_FREE") ? WaveTruncation::free : WaveTruncation::absorbing, prm, zero);
     if (stats)
       *stats = pd.absorbing_boundary().statistics();
+    if (diag)
+      {
+        *diag = pd.spectral_diagnostics(20000);
+        if (positions)
+          *positions = pd.discretization().position;
+        std::cout << "    dominant mode peaks at " << pd.describe_absorbing_node(diag->peak_absorbing) << std::endl;
+        if (n_up)
+          *n_up = diag->n_unstable;
+        if (dominant)
+          *dominant = diag->dominant;
+        return diag->radius;
+      }
     return pd.one_step_spectral_radius(20000, n_up, dominant);
   }
 
@@ -794,15 +807,36 @@ namespace
     prm.cloud_radius             = env("WAVE_CR", 0.);
     prm.max_update_norm          = env("WAVE_VMAX", 2.);
     prm.n_time_levels            = env("WAVE_LEVELS", 2);
+    if (std::getenv("WAVE_CLOUD"))
+      prm.cloud_points = std::getenv("WAVE_CLOUD");
     if (std::getenv("WAVE_DISP"))
       prm.dispersion = std::getenv("WAVE_DISP");
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
     Timer               timer;
     std::complex<double> dom;
+    WaveSpectralDiagnostics diag;
+    std::vector<Point<2>>   pos;
+    const bool              with_diag = std::getenv("WAVE_DIAG") != nullptr;
     const double        rho = env("WAVE_DIM", 2) == 1 ?
                                 radius_1d(env("WAVE_R", 10.), prm, &n_up, &dom) :
-                                radius_2d(env("WAVE_R", 3.), prm, env("WAVE_DX", 0.25), env("WAVE_M", 6), &n_up, &st, &dom);
+                                radius_2d(env("WAVE_R", 3.), prm, env("WAVE_DX", 0.25), env("WAVE_M", 6), &n_up, &st, &dom,
+                                          with_diag ? &diag : nullptr, &pos);
+    if (with_diag)
+      {
+        // Radial profile of the dominant eigenvector (max |u|, |v| per shell of width dx).
+        std::map<long, std::pair<double, double>> shells;
+        for (unsigned int i = 0; i < pos.size() && i < diag.mode_u.size(); ++i)
+          {
+            auto &sh  = shells[std::lround(pos[i].norm() / env("WAVE_DX", 0.25))];
+            sh.first  = std::max(sh.first, diag.mode_u[i]);
+            sh.second = std::max(sh.second, diag.mode_v[i]);
+          }
+        std::cout << "    layer fraction " << diag.layer_fraction << ", absorbing v fraction " << diag.absorbing_v_fraction << "\n    shell max|u| max|v|:";
+        for (const auto &sh : shells)
+          std::cout << " [" << sh.first << ": " << sci(sh.second.first) << " " << sci(sh.second.second) << "]";
+        std::cout << std::endl;
+      }
     std::cout << "    rho - 1 = " << sci(rho - 1.) << " unstable eigenvalues " << n_up << " arg " << std::arg(dom) << " cond "
               << sci(st.max_condition_number) << " max|V| " << sci(st.max_update_norm) << " thinned "
               << st.n_thinned << " stride " << st.max_stride << " clouds " << st.min_cloud_size << ".."
