@@ -54,6 +54,9 @@ namespace PeriDEAL
       prm.declare_entry("Spectral radius check size", "0", Patterns::Integer(0),
                         "PD, serial runs: largest state size (2 n_nodes + 2 n_cloud_points) for which "
                         "setup computes the spectral radius of the one-step map (0: never).");
+      prm.declare_entry("Thinning", "nearest", Patterns::Selection("nearest|average"),
+                        "Auxiliary-grid thinning (Fig. 4.23): the nearest node (the source) or the "
+                        "mean of the nodes in each auxiliary cell (filters the shortest lattice waves).");
       prm.declare_entry("Cloud points", "all", Patterns::Selection("all|interior"),
                         "PD: all points of the cone (the source) or only non-absorbing ones.");
       prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
@@ -78,6 +81,7 @@ namespace PeriDEAL
       n_time_levels            = prm.get_integer("Time levels");
       max_spectral_radius      = prm.get_double("Maximum spectral radius");
       cloud_points             = prm.get("Cloud points");
+      thinning                 = prm.get("Thinning");
     }
 
 
@@ -383,18 +387,35 @@ namespace PeriDEAL
           bool         ok = false;
           unsigned int stride = 1;
           std::vector<std::pair<unsigned int, Tensor<1, dim>>> cloud;
+          // Per cloud entry: the cone candidates it stands for and their
+          // weights (one with weight 1, or a block average, see below).
+          std::vector<std::vector<std::pair<unsigned int, double>>> members;
+          const bool average = prm.thinning == "average";
           for (; stride <= 8 && !ok; ++stride)
             {
               // Auxiliary grid of spacing stride * dx in the local frame
-              // (Fig. 4.23); keep the candidate nearest to each auxiliary node.
+              // (Fig. 4.23); keep the candidate nearest to each auxiliary node
+              // ("nearest", the source) or the mean of the candidates in its
+              // block |x bar - g|_inf < stride dx / 2 ("average"): sampling
+              // every stride-th node aliases the shortest lattice waves onto
+              // smooth ones, the block mean filters them out.
               cloud.assign(1, cone[0]);
+              members.assign(1, {{0u, 1.}});
               if (stride == 1)
-                cloud = cone;
+                {
+                  cloud = cone;
+                  members.clear();
+                  for (unsigned int c = 0; c < cone.size(); ++c)
+                    members.push_back({{c, 1.}});
+                }
               else
                 {
                   std::set<unsigned int> taken{0};
                   const double           hs = stride * dx;
                   const int              na = int(std::floor(r / hs + 1e-9));
+                  std::vector<std::pair<types::global_dof_index, std::size_t>> order;
+                  std::vector<std::pair<unsigned int, Tensor<1, dim>>>           entries;
+                  std::vector<std::vector<std::pair<unsigned int, double>>>     groups;
                   for (int ax = 1; ax <= na; ++ax)
                     for (int ay = (dim == 2 ? -na : 0); ay <= (dim == 2 ? na : 0); ++ay)
                       {
@@ -407,25 +428,46 @@ namespace PeriDEAL
                           continue;
                         unsigned int best = 0;
                         double       dist = std::numeric_limits<double>::max();
+                        std::vector<unsigned int> block;
                         for (unsigned int c = 1; c < cone.size(); ++c)
                           {
-                            const double dd = (cone[c].second - g).norm();
+                            const Tensor<1, dim> off = cone[c].second - g;
+                            const double         dd  = off.norm();
                             if (dd < dist - 1e-12 * dx)
                               {
                                 dist = dd;
                                 best = c;
                               }
+                            double inf = 0.;
+                            for (unsigned int q = 0; q < dim; ++q)
+                              inf = std::max(inf, std::abs(off[q]));
+                            if (inf < 0.5 * hs * (1. - 1e-10))
+                              block.push_back(c);
                           }
-                        if (best > 0 && dist < 0.5 * hs && taken.insert(best).second)
-                          cloud.push_back(cone[best]);
+                        if (best == 0 || dist >= 0.5 * hs || !taken.insert(best).second)
+                          continue;
+                        std::vector<std::pair<unsigned int, double>> group;
+                        if (average && !block.empty())
+                          for (const unsigned int c : block)
+                            group.emplace_back(c, 1. / block.size());
+                        else
+                          group.emplace_back(best, 1.);
+                        order.emplace_back(ids[cone[best].first], entries.size());
+                        entries.push_back(cone[best]);
+                        groups.push_back(group);
                       }
-                  std::sort(cloud.begin() + 1, cloud.end(), [&ids](const auto &p, const auto &q) {
-                    return ids[p.first] < ids[q.first];
-                  });
+                  // Rank-independent order: by the global id of the nearest candidate.
+                  std::sort(order.begin(), order.end());
+                  for (const auto &o : order)
+                    {
+                      cloud.push_back(entries[o.second]);
+                      members.push_back(groups[o.second]);
+                    }
                 }
               if (cloud.size() < 2)
                 break;
-              // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt).
+              // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt)
+              // (block means of the modes for averaged entries).
               CMatrix MG(2 * cloud.size(), n_modes), MH(2 * cloud.size(), n_modes);
               CRow    psi_g(n_modes), psi_h(n_modes);
               for (unsigned int l = 0; l < phi.size(); ++l)
@@ -439,9 +481,11 @@ namespace PeriDEAL
                         {
                           // One time level: the rows of level n-1 vanish
                           // (their updating coefficients become 0).
-                          MG(2 * j + s, c) = s < prm.n_time_levels ?
-                                               mode(cloud[j].second, -double(s) * dt, l, m) :
-                                               std::complex<double>(0.);
+                          std::complex<double> value = 0.;
+                          if (s < prm.n_time_levels)
+                            for (const auto &q : members[j])
+                              value += q.second * mode(cone[q.first].second, -double(s) * dt, l, m);
+                          MG(2 * j + s, c) = value;
                           MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
                         }
                   }
@@ -480,13 +524,32 @@ namespace PeriDEAL
           info.push_back(ci);
           min_size   = std::min<unsigned int>(min_size, cloud.size());
           max_size   = std::max<unsigned int>(max_size, cloud.size());
+          // Coefficients per point: an averaged entry spreads its V over its
+          // block (points in id order for a rank-independent sum).
+          std::map<types::global_dof_index, std::pair<unsigned int, std::array<double, 4>>> coeff;
           for (unsigned int j = 0; j < cloud.size(); ++j)
+            for (const auto &q : members[j])
+              {
+                const unsigned int p  = cone[q.first].first;
+                auto              &cf = coeff[ids[p]];
+                cf.first              = p;
+                cf.second[0] += q.second * fg.V[2 * j];
+                cf.second[1] += q.second * fg.V[2 * j + 1];
+                cf.second[2] += q.second * fh.V[2 * j];
+                cf.second[3] += q.second * fh.V[2 * j + 1];
+              }
+          // x_i first (as before), then by global id.
+          std::vector<std::pair<unsigned int, std::array<double, 4>>> sorted_coeff{coeff[ids[i]]};
+          for (const auto &cf : coeff)
+            if (cf.first != ids[i])
+              sorted_coeff.push_back(cf.second);
+          for (const auto &cf : sorted_coeff)
             {
-              cloud_index.push_back(cloud[j].first);
-              vg_now.push_back(fg.V[2 * j]);
-              vg_old.push_back(fg.V[2 * j + 1]);
-              vh_now.push_back(fh.V[2 * j]);
-              vh_old.push_back(fh.V[2 * j + 1]);
+              cloud_index.push_back(cf.first);
+              vg_now.push_back(cf.second[0]);
+              vg_old.push_back(cf.second[1]);
+              vh_now.push_back(cf.second[2]);
+              vh_old.push_back(cf.second[3]);
             }
           cloud_start.push_back(cloud_index.size());
         }

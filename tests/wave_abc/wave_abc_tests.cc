@@ -766,10 +766,26 @@ namespace
         }
       catch (const ParameterError &e)
         {
-          thrown = std::string(e.what()).find("spectral radius") != std::string::npos;
-          std::cout << "    guard: " << std::string(e.what()).substr(0, 160) << "..." << std::endl;
+          const std::string what = e.what();
+          thrown = what.find("spectral radius") != std::string::npos &&
+                   what.find("peaks at the absorbing node") != std::string::npos && what.find("cond(M_G)") != std::string::npos;
+          std::cout << "    guard: " << what.substr(0, 600) << "..." << std::endl;
         }
-      check(thrown, "setup with the spectral check rejects n_b = 5 with a ParameterError");
+      check(thrown, "setup with the spectral check rejects n_b = 5 with a ParameterError naming the absorbing node and its cloud's numbers");
+    }
+    // The diagnostics locate the growing mode: same radius as the plain
+    // computation, and (the interior being energy-conserving, d = 0) the
+    // mode lives in the absorbing layer.
+    {
+      WaveAbcParameters five = prm;
+      five.spectral_check_size = 0;
+      PdUnboundedWave<1> pd(MPI_COMM_SELF);
+      pd.setup(bar, lp, mp, WaveTruncation::absorbing, five, u0);
+      const WaveSpectralDiagnostics diag = pd.spectral_diagnostics();
+      std::cout << "    n_b = 5 diagnostics: rho " << diag.radius << ", layer fraction " << diag.layer_fraction << ", peak at "
+                << pd.describe_absorbing_node(diag.peak_absorbing) << std::endl;
+      check_close(diag.radius, rho[5], 1e-12, "diagnostics: same spectral radius as one_step_spectral_radius (n_b = 5)");
+      check(diag.layer_fraction > 0.5, "n_b = 5: the growing mode has most of its norm in the absorbing layer");
     }
     prm.n_wave_numbers      = 1;
     prm.max_spectral_radius = 1. + 1e-4;
@@ -785,11 +801,33 @@ namespace
     p2.cone_angle = 0.5;
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
-    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st);
+    std::complex<double> dom2;
+    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2);
     std::cout << "    2D R = 2.5, cone 0.5: rho - 1 = " << sci(rho2 - 1.) << " (" << n_up << " eigenvalues > 1 + 1e-8), cond "
               << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     check(st.max_condition_number <= 1e12 && st.max_update_norm <= 2. && rho2 > 1. + 1e-4,
           "2D: local guards hold but rho > 1 + 1e-4 (known, doc/design.md)");
+    // Where the 2D instability sits: its frequency arg(lambda)/dt is the top
+    // of the discrete PD spectrum, max_k sqrt(Omega^2(k) - d^2) over the
+    // Brillouin zone |k_i| <= pi/dx (the plateau of short waves with ~zero
+    // group velocity, far outside the fitted band |k| <= Delta k = 1).
+    {
+      const auto   rel  = WaveDispersion<2>::discrete(wave_kernel(2, 2., InfluenceFunction::constant, 1.5, 1.), 0.25, true, 0.0125);
+      double       wmax = 0.;
+      const double kn   = M_PI / 0.25;
+      for (unsigned int i = 0; i <= 64; ++i)
+        for (unsigned int j = 0; j <= 64; ++j)
+          {
+            Tensor<1, 2> kv;
+            kv[0] = kn * i / 64.;
+            kv[1] = kn * j / 64.;
+            wmax  = std::max(wmax, std::sqrt(rel.symbol(kv) - 0.0125 * 0.0125));
+          }
+      const double w_dominant = std::abs(std::arg(dom2)) / 0.02;
+      std::cout << "    2D dominant frequency " << w_dominant << ", top of the discrete spectrum " << wmax
+                << " (at Delta k = 1: " << std::sqrt(rel.symbol(wave_vector(1., 0.))) << ")" << std::endl;
+      check(std::abs(w_dominant - wmax) < 0.1 * wmax, "2D: the growing mode oscillates at the top of the discrete PD spectrum (within 10%)");
+    }
   }
 
   // Exploration of the one-step spectral radius (environment-driven).
@@ -809,6 +847,8 @@ namespace
     prm.n_time_levels            = env("WAVE_LEVELS", 2);
     if (std::getenv("WAVE_CLOUD"))
       prm.cloud_points = std::getenv("WAVE_CLOUD");
+    if (std::getenv("WAVE_THIN"))
+      prm.thinning = std::getenv("WAVE_THIN");
     if (std::getenv("WAVE_DISP"))
       prm.dispersion = std::getenv("WAVE_DISP");
     unsigned int        n_up = 0;

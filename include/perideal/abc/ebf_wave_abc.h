@@ -75,6 +75,13 @@ namespace PeriDEAL
        * absorbing value is extrapolated from extrapolated values).
        */
       std::string cloud_points = "all";
+      /**
+       * Auxiliary-grid thinning (Fig. 4.23): "nearest" (the source: the node
+       * nearest to each auxiliary node) or "average" (the mean of the nodes
+       * in each auxiliary cell, which does not alias the shortest lattice
+       * waves onto smooth ones).
+       */
+      std::string thinning = "nearest";
 
       static void
       declare_parameters(ParameterHandler &prm);
