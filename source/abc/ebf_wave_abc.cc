@@ -54,6 +54,11 @@ namespace PeriDEAL
       prm.declare_entry("Spectral radius check size", "0", Patterns::Integer(0),
                         "PD, serial runs: largest state size (2 n_nodes + 2 n_cloud_points) for which "
                         "setup computes the spectral radius of the one-step map (0: never).");
+      prm.declare_entry("Thinning", "nearest", Patterns::Selection("nearest|average"),
+                        "Auxiliary-grid thinning (Fig. 4.23): the nearest node (the source) or the "
+                        "mean of the nodes in each auxiliary cell (filters the shortest lattice waves).");
+      prm.declare_entry("Cloud points", "all", Patterns::Selection("all|interior"),
+                        "PD: all points of the cone (the source) or only non-absorbing ones.");
       prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
                         "Setup throws ParameterError if the checked spectral radius exceeds this.");
     }
@@ -75,6 +80,8 @@ namespace PeriDEAL
       spectral_check_size      = prm.get_integer("Spectral radius check size");
       n_time_levels            = prm.get_integer("Time levels");
       max_spectral_radius      = prm.get_double("Maximum spectral radius");
+      cloud_points             = prm.get("Cloud points");
+      thinning                 = prm.get("Thinning");
     }
 
 
@@ -263,7 +270,8 @@ namespace PeriDEAL
                             const double                                dt,
                             const double                                dx,
                             const WaveAbcParameters                    &prm,
-                            const MPI_Comm                              comm)
+                            const MPI_Comm                              comm,
+                            const std::vector<bool>                    &excluded)
     {
       AssertDimension(points.size(), ids.size());
       AssertDimension(absorbing_in.size(), normals.size());
@@ -281,6 +289,7 @@ namespace PeriDEAL
       vg_old.clear();
       vh_now.clear();
       vh_old.clear();
+      info.clear();
       stats = WaveCloudStatistics();
 
       // Mode parameters (4.56), (4.98): k_m and phi_l in the local frame.
@@ -359,7 +368,8 @@ namespace PeriDEAL
                 continue;
               for (const unsigned int j : it->second)
                 {
-                  if (j == i || xi.distance(points[j]) > r * (1. + 1e-10))
+                  if (j == i || xi.distance(points[j]) > r * (1. + 1e-10) ||
+                      (!excluded.empty() && excluded[j]))
                     continue;
                   const Tensor<1, dim> xbar = R * (points[j] - xi);
                   const double         lat  = dim == 2 ? std::abs(xbar[dim - 1]) : 0.;
@@ -377,18 +387,35 @@ namespace PeriDEAL
           bool         ok = false;
           unsigned int stride = 1;
           std::vector<std::pair<unsigned int, Tensor<1, dim>>> cloud;
+          // Per cloud entry: the cone candidates it stands for and their
+          // weights (one with weight 1, or a block average, see below).
+          std::vector<std::vector<std::pair<unsigned int, double>>> members;
+          const bool average = prm.thinning == "average";
           for (; stride <= 8 && !ok; ++stride)
             {
               // Auxiliary grid of spacing stride * dx in the local frame
-              // (Fig. 4.23); keep the candidate nearest to each auxiliary node.
+              // (Fig. 4.23); keep the candidate nearest to each auxiliary node
+              // ("nearest", the source) or the mean of the candidates in its
+              // block |x bar - g|_inf < stride dx / 2 ("average"): sampling
+              // every stride-th node aliases the shortest lattice waves onto
+              // smooth ones, the block mean filters them out.
               cloud.assign(1, cone[0]);
+              members.assign(1, {{0u, 1.}});
               if (stride == 1)
-                cloud = cone;
+                {
+                  cloud = cone;
+                  members.clear();
+                  for (unsigned int c = 0; c < cone.size(); ++c)
+                    members.push_back({{c, 1.}});
+                }
               else
                 {
                   std::set<unsigned int> taken{0};
                   const double           hs = stride * dx;
                   const int              na = int(std::floor(r / hs + 1e-9));
+                  std::vector<std::pair<types::global_dof_index, std::size_t>> order;
+                  std::vector<std::pair<unsigned int, Tensor<1, dim>>>           entries;
+                  std::vector<std::vector<std::pair<unsigned int, double>>>     groups;
                   for (int ax = 1; ax <= na; ++ax)
                     for (int ay = (dim == 2 ? -na : 0); ay <= (dim == 2 ? na : 0); ++ay)
                       {
@@ -401,25 +428,46 @@ namespace PeriDEAL
                           continue;
                         unsigned int best = 0;
                         double       dist = std::numeric_limits<double>::max();
+                        std::vector<unsigned int> block;
                         for (unsigned int c = 1; c < cone.size(); ++c)
                           {
-                            const double dd = (cone[c].second - g).norm();
+                            const Tensor<1, dim> off = cone[c].second - g;
+                            const double         dd  = off.norm();
                             if (dd < dist - 1e-12 * dx)
                               {
                                 dist = dd;
                                 best = c;
                               }
+                            double inf = 0.;
+                            for (unsigned int q = 0; q < dim; ++q)
+                              inf = std::max(inf, std::abs(off[q]));
+                            if (inf < 0.5 * hs * (1. - 1e-10))
+                              block.push_back(c);
                           }
-                        if (best > 0 && dist < 0.5 * hs && taken.insert(best).second)
-                          cloud.push_back(cone[best]);
+                        if (best == 0 || dist >= 0.5 * hs || !taken.insert(best).second)
+                          continue;
+                        std::vector<std::pair<unsigned int, double>> group;
+                        if (average && !block.empty())
+                          for (const unsigned int c : block)
+                            group.emplace_back(c, 1. / block.size());
+                        else
+                          group.emplace_back(best, 1.);
+                        order.emplace_back(ids[cone[best].first], entries.size());
+                        entries.push_back(cone[best]);
+                        groups.push_back(group);
                       }
-                  std::sort(cloud.begin() + 1, cloud.end(), [&ids](const auto &p, const auto &q) {
-                    return ids[p.first] < ids[q.first];
-                  });
+                  // Rank-independent order: by the global id of the nearest candidate.
+                  std::sort(order.begin(), order.end());
+                  for (const auto &o : order)
+                    {
+                      cloud.push_back(entries[o.second]);
+                      members.push_back(groups[o.second]);
+                    }
                 }
               if (cloud.size() < 2)
                 break;
-              // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt).
+              // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt)
+              // (block means of the modes for averaged entries).
               CMatrix MG(2 * cloud.size(), n_modes), MH(2 * cloud.size(), n_modes);
               CRow    psi_g(n_modes), psi_h(n_modes);
               for (unsigned int l = 0; l < phi.size(); ++l)
@@ -433,9 +481,11 @@ namespace PeriDEAL
                         {
                           // One time level: the rows of level n-1 vanish
                           // (their updating coefficients become 0).
-                          MG(2 * j + s, c) = s < prm.n_time_levels ?
-                                               mode(cloud[j].second, -double(s) * dt, l, m) :
-                                               std::complex<double>(0.);
+                          std::complex<double> value = 0.;
+                          if (s < prm.n_time_levels)
+                            for (const auto &q : members[j])
+                              value += q.second * mode(cone[q.first].second, -double(s) * dt, l, m);
+                          MG(2 * j + s, c) = value;
                           MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
                         }
                   }
@@ -464,15 +514,42 @@ namespace PeriDEAL
           max_stride = std::max(max_stride, stride);
           max_cond   = std::max({max_cond, fg.cond, fh.cond});
           max_norm   = std::max({max_norm, fg.vmax, fh.vmax});
+          WaveCloudInfo ci;
+          ci.cond_g    = fg.cond;
+          ci.cond_h    = fh.cond;
+          ci.vmax_g    = fg.vmax;
+          ci.vmax_h    = fh.vmax;
+          ci.row_sum_g = fg.V.cwiseAbs().sum();
+          ci.stride    = stride;
+          info.push_back(ci);
           min_size   = std::min<unsigned int>(min_size, cloud.size());
           max_size   = std::max<unsigned int>(max_size, cloud.size());
+          // Coefficients per point: an averaged entry spreads its V over its
+          // block (points in id order for a rank-independent sum).
+          std::map<types::global_dof_index, std::pair<unsigned int, std::array<double, 4>>> coeff;
           for (unsigned int j = 0; j < cloud.size(); ++j)
+            for (const auto &q : members[j])
+              {
+                const unsigned int p  = cone[q.first].first;
+                auto              &cf = coeff[ids[p]];
+                cf.first              = p;
+                cf.second[0] += q.second * fg.V[2 * j];
+                cf.second[1] += q.second * fg.V[2 * j + 1];
+                cf.second[2] += q.second * fh.V[2 * j];
+                cf.second[3] += q.second * fh.V[2 * j + 1];
+              }
+          // x_i first (as before), then by global id.
+          std::vector<std::pair<unsigned int, std::array<double, 4>>> sorted_coeff{coeff[ids[i]]};
+          for (const auto &cf : coeff)
+            if (cf.first != ids[i])
+              sorted_coeff.push_back(cf.second);
+          for (const auto &cf : sorted_coeff)
             {
-              cloud_index.push_back(cloud[j].first);
-              vg_now.push_back(fg.V[2 * j]);
-              vg_old.push_back(fg.V[2 * j + 1]);
-              vh_now.push_back(fh.V[2 * j]);
-              vh_old.push_back(fh.V[2 * j + 1]);
+              cloud_index.push_back(cf.first);
+              vg_now.push_back(cf.second[0]);
+              vg_old.push_back(cf.second[1]);
+              vh_now.push_back(cf.second[2]);
+              vh_old.push_back(cf.second[3]);
             }
           cloud_start.push_back(cloud_index.size());
         }
@@ -606,8 +683,14 @@ namespace PeriDEAL
       std::vector<Tensor<1, dim>> normals;
       find_absorbing_layer(disc, domain, layer, prm.cloud_radius, nodes, normals);
       std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
+      // "interior": no absorbing point (owned or ghost, by the same distance
+      // test as find_absorbing_layer) in any cloud.
+      std::vector<bool> excluded;
+      if (prm.cloud_points == "interior")
+        for (const auto &p : disc.position)
+          excluded.push_back(-domain.signed_distance(p) < layer - 1e-8 * lattice.dx);
       abc.reinit(disc.position, ids, nodes, normals, *relation, dt, lattice.dx, prm,
-                 disc.get_mpi_communicator());
+                 disc.get_mpi_communicator(), excluded);
       // The local guards do not imply stability of the coupled recursion
       // (doc/design.md): check the global one-step map where affordable.
       const std::size_t state = 2 * std::size_t(disc.n_owned()) + 2 * abc.cloud_points().size();
@@ -619,13 +702,18 @@ namespace PeriDEAL
           spectral_radius = one_step_spectral_radius(prm.spectral_check_size, &n_up, &dominant);
           if (spectral_radius > prm.max_spectral_radius)
             {
+              // Locate the growing mode: the absorbing node (and cloud)
+              // where the dominant eigenvector is largest.
+              const WaveSpectralDiagnostics diag = spectral_diagnostics(prm.spectral_check_size);
               std::ostringstream v;
               v.precision(10);
               v << "one-step spectral radius " << spectral_radius << " (" << n_up
                 << " eigenvalues of modulus > 1 + 1e-8, dominant angle " << std::arg(dominant)
                 << " per step) of the near field with the absorbing boundary (" << state
                 << " state entries; every cloud passed cond <= " << prm.max_condition_number
-                << ", max |V| <= " << prm.max_update_norm << ")";
+                << ", max |V| <= " << prm.max_update_norm << "); the dominant mode peaks at the "
+                << describe_absorbing_node(diag.peak_absorbing) << " and has "
+                << diag.layer_fraction << " of its norm in the absorbing layer";
               throw ParameterError("Absorbing boundary/Maximum spectral radius", v.str(),
                                    "<= " + std::to_string(prm.max_spectral_radius) +
                                      " (unstable: change the mode set, cone or layer)");
@@ -681,10 +769,8 @@ namespace PeriDEAL
     }
 
     template <int dim>
-    double
-    PdUnboundedWave<dim>::one_step_spectral_radius(const unsigned int    max_size,
-                                                   unsigned int         *n_unstable,
-                                                   std::complex<double> *dominant)
+    unsigned int
+    PdUnboundedWave<dim>::assemble_one_step_map(const unsigned int max_size, std::vector<double> &map)
     {
       const MPI_Comm comm = disc.get_mpi_communicator();
       check_parameter(Utilities::MPI::n_mpi_processes(comm) == 1, "MPI ranks",
@@ -719,24 +805,25 @@ namespace PeriDEAL
         for (unsigned int i = 0; i < n; ++i)
           a.local_element(i) = Lu.local_element(i) - 2. * d * v.local_element(i);
       };
-      LAPACKFullMatrix<double> map(m, m);
-      std::vector<double>      x(m);
+      map.assign(std::size_t(m) * m, 0.);
+      std::vector<double> x(m);
       for (unsigned int col = 0; col < m; ++col)
         {
           std::fill(x.begin(), x.end(), 0.);
           x[col] = 1.;
           set_state(x);
           advance();
+          double *column = map.data() + std::size_t(col) * m;
           for (unsigned int i = 0; i < n; ++i)
             {
-              map(i, col)     = u.local_element(i);
-              map(n + i, col) = v.local_element(i);
+              column[i]     = u.local_element(i);
+              column[n + i] = v.local_element(i);
             }
           if (absorbing)
             for (unsigned int q = 0; q < c.size(); ++q)
               {
-                map(2 * n + q, col)            = u_old[c[q]];
-                map(2 * n + c.size() + q, col) = v_old[c[q]];
+                column[2 * n + q]            = u_old[c[q]];
+                column[2 * n + c.size() + q] = v_old[c[q]];
               }
         }
       u     = u0;
@@ -749,6 +836,21 @@ namespace PeriDEAL
       t            = t0;
       abc_seconds  = abc0;
       step_seconds = step0;
+      return m;
+    }
+
+    template <int dim>
+    double
+    PdUnboundedWave<dim>::one_step_spectral_radius(const unsigned int    max_size,
+                                                   unsigned int         *n_unstable,
+                                                   std::complex<double> *dominant)
+    {
+      std::vector<double>      dense;
+      const unsigned int       m = assemble_one_step_map(max_size, dense);
+      LAPACKFullMatrix<double> map(m, m);
+      for (unsigned int col = 0; col < m; ++col)
+        for (unsigned int i = 0; i < m; ++i)
+          map(i, col) = dense[std::size_t(col) * m + i];
       map.compute_eigenvalues(false, false);
       double       rho = 0.;
       unsigned int n_up = 0;
@@ -763,6 +865,92 @@ namespace PeriDEAL
       if (n_unstable)
         *n_unstable = n_up;
       return rho;
+    }
+
+    template <int dim>
+    WaveSpectralDiagnostics
+    PdUnboundedWave<dim>::spectral_diagnostics(const unsigned int max_size)
+    {
+      WaveSpectralDiagnostics r;
+      std::vector<double>     dense;
+      const unsigned int      m = assemble_one_step_map(max_size, dense);
+      const Eigen::Map<const Eigen::MatrixXd> A(dense.data(), m, m);
+      {
+        LAPACKFullMatrix<double> map(m, m);
+        for (unsigned int col = 0; col < m; ++col)
+          for (unsigned int i = 0; i < m; ++i)
+            map(i, col) = A(i, col);
+        map.compute_eigenvalues(false, false);
+        for (unsigned int i = 0; i < m; ++i)
+          {
+            const double mod = std::abs(map.eigenvalue(i));
+            if (mod > r.radius)
+              {
+                r.radius   = mod;
+                r.dominant = map.eigenvalue(i);
+              }
+            r.n_unstable += mod > 1. + 1e-8 ? 1 : 0;
+          }
+      }
+      // Inverse iteration with a shift next to the dominant eigenvalue.
+      const std::complex<double> shift = r.dominant * (1. + 1e-9);
+      const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(
+        A.cast<std::complex<double>>() - shift * Eigen::MatrixXcd::Identity(m, m));
+      Eigen::VectorXcd x = Eigen::VectorXcd::Ones(m);
+      for (unsigned int it = 0; it < 4; ++it)
+        {
+          x = lu.solve(x);
+          x /= x.norm();
+        }
+      const unsigned int               n = disc.n_owned();
+      const std::vector<unsigned int> &c = abc.cloud_points();
+      r.mode_u.resize(n);
+      r.mode_v.resize(n);
+      double peak = 0.;
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          r.mode_u[i] = std::abs(x[i]);
+          r.mode_v[i] = std::abs(x[n + i]);
+          peak        = std::max({peak, r.mode_u[i], r.mode_v[i]});
+        }
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          r.mode_u[i] /= peak;
+          r.mode_v[i] /= peak;
+        }
+      const auto &nodes = abc.absorbing_points();
+      std::vector<unsigned int> sorted(nodes);
+      std::sort(sorted.begin(), sorted.end());
+      double      best  = -1.;
+      for (unsigned int q = 0; q < nodes.size(); ++q)
+        {
+          const unsigned int i = nodes[q];
+          r.layer_fraction += std::norm(x[i]) + std::norm(x[n + i]);
+          r.absorbing_v_fraction += std::norm(x[n + i]);
+          if (std::abs(x[i]) + std::abs(x[n + i]) > best)
+            {
+              best             = std::abs(x[i]) + std::abs(x[n + i]);
+              r.peak_absorbing = q;
+            }
+        }
+      if (absorbing)
+        for (unsigned int q = 2 * n; q < m; ++q)
+          r.layer_fraction += std::norm(x[q]) * (std::binary_search(sorted.begin(), sorted.end(), c[(q - 2 * n) % c.size()]) ? 1. : 0.);
+      return r;
+    }
+
+    template <int dim>
+    std::string
+    PdUnboundedWave<dim>::describe_absorbing_node(const unsigned int q) const
+    {
+      std::ostringstream s;
+      const unsigned int i  = abc.absorbing_points()[q];
+      const auto        &ci = abc.cloud_info(q);
+      s << "absorbing node " << disc.id[i] << " at (" << disc.position[i] << "): cloud of "
+        << abc.cloud(q).size() << " points (stride " << ci.stride << "), cond(M_G) " << ci.cond_g
+        << ", cond(M_H) " << ci.cond_h << ", max |V_G| " << ci.vmax_g << ", max |V_H| " << ci.vmax_h
+        << ", sum |V_G| " << ci.row_sum_g;
+      return s.str();
     }
 
     template <int dim>

@@ -616,7 +616,8 @@ namespace
   double
   radius_2d(const double R, const WaveAbcParameters &prm, const double dx = 0.25,
             const double m = 6, unsigned int *n_up = nullptr, WaveCloudStatistics *stats = nullptr,
-            std::complex<double> *dominant = nullptr)
+            std::complex<double> *dominant = nullptr, WaveSpectralDiagnostics *diag = nullptr,
+            std::vector<Point<2>> *positions = nullptr)
   {
     LatticeParameters lp;
     lp.dx    = dx;
@@ -631,6 +632,18 @@ namespace
     pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, std::getenv("WAVE_FREE") ? WaveTruncation::free : WaveTruncation::absorbing, prm, zero);
     if (stats)
       *stats = pd.absorbing_boundary().statistics();
+    if (diag)
+      {
+        *diag = pd.spectral_diagnostics(20000);
+        if (positions)
+          *positions = pd.discretization().position;
+        std::cout << "    dominant mode peaks at " << pd.describe_absorbing_node(diag->peak_absorbing) << std::endl;
+        if (n_up)
+          *n_up = diag->n_unstable;
+        if (dominant)
+          *dominant = diag->dominant;
+        return diag->radius;
+      }
     return pd.one_step_spectral_radius(20000, n_up, dominant);
   }
 
@@ -753,10 +766,26 @@ namespace
         }
       catch (const ParameterError &e)
         {
-          thrown = std::string(e.what()).find("spectral radius") != std::string::npos;
-          std::cout << "    guard: " << std::string(e.what()).substr(0, 160) << "..." << std::endl;
+          const std::string what = e.what();
+          thrown = what.find("spectral radius") != std::string::npos &&
+                   what.find("peaks at the absorbing node") != std::string::npos && what.find("cond(M_G)") != std::string::npos;
+          std::cout << "    guard: " << what.substr(0, 600) << "..." << std::endl;
         }
-      check(thrown, "setup with the spectral check rejects n_b = 5 with a ParameterError");
+      check(thrown, "setup with the spectral check rejects n_b = 5 with a ParameterError naming the absorbing node and its cloud's numbers");
+    }
+    // The diagnostics locate the growing mode: same radius as the plain
+    // computation, and (the interior being energy-conserving, d = 0) the
+    // mode lives in the absorbing layer.
+    {
+      WaveAbcParameters five = prm;
+      five.spectral_check_size = 0;
+      PdUnboundedWave<1> pd(MPI_COMM_SELF);
+      pd.setup(bar, lp, mp, WaveTruncation::absorbing, five, u0);
+      const WaveSpectralDiagnostics diag = pd.spectral_diagnostics();
+      std::cout << "    n_b = 5 diagnostics: rho " << diag.radius << ", layer fraction " << diag.layer_fraction << ", peak at "
+                << pd.describe_absorbing_node(diag.peak_absorbing) << std::endl;
+      check_close(diag.radius, rho[5], 1e-12, "diagnostics: same spectral radius as one_step_spectral_radius (n_b = 5)");
+      check(diag.layer_fraction > 0.5, "n_b = 5: the growing mode has most of its norm in the absorbing layer");
     }
     prm.n_wave_numbers      = 1;
     prm.max_spectral_radius = 1. + 1e-4;
@@ -772,11 +801,33 @@ namespace
     p2.cone_angle = 0.5;
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
-    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st);
+    std::complex<double> dom2;
+    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2);
     std::cout << "    2D R = 2.5, cone 0.5: rho - 1 = " << sci(rho2 - 1.) << " (" << n_up << " eigenvalues > 1 + 1e-8), cond "
               << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     check(st.max_condition_number <= 1e12 && st.max_update_norm <= 2. && rho2 > 1. + 1e-4,
           "2D: local guards hold but rho > 1 + 1e-4 (known, doc/design.md)");
+    // Where the 2D instability sits: its frequency arg(lambda)/dt is the top
+    // of the discrete PD spectrum, max_k sqrt(Omega^2(k) - d^2) over the
+    // Brillouin zone |k_i| <= pi/dx (the plateau of short waves with ~zero
+    // group velocity, far outside the fitted band |k| <= Delta k = 1).
+    {
+      const auto   rel  = WaveDispersion<2>::discrete(wave_kernel(2, 2., InfluenceFunction::constant, 1.5, 1.), 0.25, true, 0.0125);
+      double       wmax = 0.;
+      const double kn   = M_PI / 0.25;
+      for (unsigned int i = 0; i <= 64; ++i)
+        for (unsigned int j = 0; j <= 64; ++j)
+          {
+            Tensor<1, 2> kv;
+            kv[0] = kn * i / 64.;
+            kv[1] = kn * j / 64.;
+            wmax  = std::max(wmax, std::sqrt(rel.symbol(kv) - 0.0125 * 0.0125));
+          }
+      const double w_dominant = std::abs(std::arg(dom2)) / 0.02;
+      std::cout << "    2D dominant frequency " << w_dominant << ", top of the discrete spectrum " << wmax
+                << " (at Delta k = 1: " << std::sqrt(rel.symbol(wave_vector(1., 0.))) << ")" << std::endl;
+      check(std::abs(w_dominant - wmax) < 0.1 * wmax, "2D: the growing mode oscillates at the top of the discrete PD spectrum (within 10%)");
+    }
   }
 
   // Exploration of the one-step spectral radius (environment-driven).
@@ -794,15 +845,38 @@ namespace
     prm.cloud_radius             = env("WAVE_CR", 0.);
     prm.max_update_norm          = env("WAVE_VMAX", 2.);
     prm.n_time_levels            = env("WAVE_LEVELS", 2);
+    if (std::getenv("WAVE_CLOUD"))
+      prm.cloud_points = std::getenv("WAVE_CLOUD");
+    if (std::getenv("WAVE_THIN"))
+      prm.thinning = std::getenv("WAVE_THIN");
     if (std::getenv("WAVE_DISP"))
       prm.dispersion = std::getenv("WAVE_DISP");
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
     Timer               timer;
     std::complex<double> dom;
+    WaveSpectralDiagnostics diag;
+    std::vector<Point<2>>   pos;
+    const bool              with_diag = std::getenv("WAVE_DIAG") != nullptr;
     const double        rho = env("WAVE_DIM", 2) == 1 ?
                                 radius_1d(env("WAVE_R", 10.), prm, &n_up, &dom) :
-                                radius_2d(env("WAVE_R", 3.), prm, env("WAVE_DX", 0.25), env("WAVE_M", 6), &n_up, &st, &dom);
+                                radius_2d(env("WAVE_R", 3.), prm, env("WAVE_DX", 0.25), env("WAVE_M", 6), &n_up, &st, &dom,
+                                          with_diag ? &diag : nullptr, &pos);
+    if (with_diag)
+      {
+        // Radial profile of the dominant eigenvector (max |u|, |v| per shell of width dx).
+        std::map<long, std::pair<double, double>> shells;
+        for (unsigned int i = 0; i < pos.size() && i < diag.mode_u.size(); ++i)
+          {
+            auto &sh  = shells[std::lround(pos[i].norm() / env("WAVE_DX", 0.25))];
+            sh.first  = std::max(sh.first, diag.mode_u[i]);
+            sh.second = std::max(sh.second, diag.mode_v[i]);
+          }
+        std::cout << "    layer fraction " << diag.layer_fraction << ", absorbing v fraction " << diag.absorbing_v_fraction << "\n    shell max|u| max|v|:";
+        for (const auto &sh : shells)
+          std::cout << " [" << sh.first << ": " << sci(sh.second.first) << " " << sci(sh.second.second) << "]";
+        std::cout << std::endl;
+      }
     std::cout << "    rho - 1 = " << sci(rho - 1.) << " unstable eigenvalues " << n_up << " arg " << std::arg(dom) << " cond "
               << sci(st.max_condition_number) << " max|V| " << sci(st.max_update_norm) << " thinned "
               << st.n_thinned << " stride " << st.max_stride << " clouds " << st.min_cloud_size << ".."

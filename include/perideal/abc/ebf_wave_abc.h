@@ -69,6 +69,19 @@ namespace PeriDEAL
       unsigned int n_time_levels = 2;
       /** Largest admissible one-step spectral radius of the checked map. */
       double max_spectral_radius = 1. + 1e-8;
+      /**
+       * PD: "all" (the source: every point of the cone, absorbing ones
+       * included) or "interior" (no absorbing point in any cloud, so that no
+       * absorbing value is extrapolated from extrapolated values).
+       */
+      std::string cloud_points = "all";
+      /**
+       * Auxiliary-grid thinning (Fig. 4.23): "nearest" (the source: the node
+       * nearest to each auxiliary node) or "average" (the mean of the nodes
+       * in each auxiliary cell, which does not alias the shortest lattice
+       * waves onto smooth ones).
+       */
+      std::string thinning = "nearest";
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -151,6 +164,36 @@ namespace PeriDEAL
       unsigned int n_thinned = 0, max_stride = 1;
     };
 
+    /** Guard numbers of one cloud (after thinning). */
+    struct WaveCloudInfo
+    {
+      /** Condition numbers of M_G, M_H and max_j |V_G,j|, max_j |V_H,j|. */
+      double cond_g = 0., cond_h = 0., vmax_g = 0., vmax_h = 0.;
+      /** sum_j |V_G,j| over both time levels (the row sum of the u update). */
+      double row_sum_g = 0.;
+      /** Auxiliary-grid stride of the retained cloud (1: not thinned). */
+      unsigned int stride = 1;
+    };
+
+    /**
+     * Result of PdUnboundedWave::one_step_spectral_radius() with the
+     * dominant eigenvector located on the nodes.
+     */
+    struct WaveSpectralDiagnostics
+    {
+      double               radius = 0.;
+      unsigned int         n_unstable = 0;
+      std::complex<double> dominant;
+      /** |u| and |v| of the dominant eigenvector per owned node (max of both = 1). */
+      std::vector<double> mode_u, mode_v;
+      /** Share of the squared dominant eigenvector on the absorbing nodes (u, v, old levels). */
+      double layer_fraction = 0.;
+      /** Share of the squared dominant eigenvector in the v entries of the absorbing nodes. */
+      double absorbing_v_fraction = 0.;
+      /** Index (into absorbing_points()) of the absorbing node with the largest |u| + |v|. */
+      unsigned int peak_absorbing = 0;
+    };
+
     /**
      * The EBF absorbing boundary for viscous scalar waves (Sect. 4.2.3):
      * for every owned absorbing node x_i a local frame with x along the
@@ -172,7 +215,8 @@ namespace PeriDEAL
        * this rank (owned and ghost, local numbering) with global ids;
        * @p absorbing: local indices of the owned absorbing points,
        * @p outward_normals their normals; @p dx the near-field spacing (for
-       * (4.83) and the auxiliary grid).
+       * (4.83) and the auxiliary grid); @p excluded (optional, per point):
+       * points that may not enter any cloud.
        */
       void
       reinit(const std::vector<Point<dim>>              &points,
@@ -183,7 +227,8 @@ namespace PeriDEAL
              const double                                time_step,
              const double                                dx,
              const WaveAbcParameters                    &parameters,
-             const MPI_Comm                              comm);
+             const MPI_Comm                              comm,
+             const std::vector<bool>                    &excluded = {});
 
       /**
        * u_new[a] = V_G . (u^n_j, u^{n-1}_j)_j, v_new[a] = V_H . (v^n_j, v^{n-1}_j)_j
@@ -216,6 +261,12 @@ namespace PeriDEAL
       {
         return stats;
       }
+      /** Guard numbers of the cloud of absorbing point a. */
+      const WaveCloudInfo &
+      cloud_info(const unsigned int a) const
+      {
+        return info[a];
+      }
       /** Rotation R with R n = e_1 (the local frame of Fig. 4.20). */
       static Tensor<2, dim>
       local_frame(const Tensor<1, dim> &outward_normal);
@@ -224,6 +275,7 @@ namespace PeriDEAL
       std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
       /** Per cloud entry: V_G and V_H for levels n and n-1. */
       std::vector<double> vg_now, vg_old, vh_now, vh_old;
+      std::vector<WaveCloudInfo> info;
       WaveCloudStatistics stats;
     };
 
@@ -279,6 +331,18 @@ namespace PeriDEAL
                                std::complex<double> *dominant   = nullptr);
 
       /**
+       * The same with the dominant eigenvector (inverse iteration with the
+       * dominant eigenvalue) located on the nodes: which absorbing node and
+       * which part of the state carry the growing mode.
+       */
+      WaveSpectralDiagnostics
+      spectral_diagnostics(const unsigned int max_size = 4000);
+
+      /** One-line description of absorbing node a and its cloud (guard numbers). */
+      std::string
+      describe_absorbing_node(const unsigned int a) const;
+
+      /**
        * Wave energy (4.99) of the nodes x_i with @p inside(x_i): 1/2 sum v_i^2 V_i +
        * 1/4 sum_i sum_j k (u_j - u_i)^2 beta V_j V_i (all ranks).
        */
@@ -323,6 +387,10 @@ namespace PeriDEAL
       double spectral_radius = 0.;
 
     private:
+      /** The dense one-step map (column-major, m x m) of one_step_spectral_radius(). */
+      unsigned int
+      assemble_one_step_map(const unsigned int max_size, std::vector<double> &map);
+
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       std::unique_ptr<WaveDispersion<dim>>    relation;
