@@ -78,6 +78,9 @@ namespace PeriDEAL
   HybridBondBasedModel<dim>::update_row_lists()
   {
     const auto &nb = disc.neighborhood;
+    wls_mask.resize(disc.position.size());
+    for (std::size_t k = 0; k < wls_mask.size(); ++k)
+      wls_mask[k] = wls_flag.local_element(k) > 0.5;
     standard_rows.clear();
     active_wls_rows.clear();
     test_rows.clear();
@@ -101,37 +104,58 @@ namespace PeriDEAL
     const unsigned int n_owned = disc.n_owned();
     const double      *w       = wls_flag.begin();
     const auto        &brk     = broken_flag;
+    (void)w;
     double            *crit    = critical.begin();
     const double      *p       = deformed.data();
     (void)u;
     std::uint64_t n_critical = 0;
+    const std::uint8_t *wf = wls_mask.data();
     for (const unsigned int i : test_rows)
       {
-        const double *pi = p + std::size_t(dim) * i;
-        const double *L2 = critical_length2.data() + nb.table_start[i];
-        const double *B2 = breaking_length2.data() + nb.table_start[i];
-        const auto    begin = nb.row_start[i];
-        for (std::uint64_t b = begin; b < nb.row_start[i + 1]; ++b)
+        const double       *pi    = p + std::size_t(dim) * i;
+        const double       *L2    = critical_length2.data() + nb.table_start[i];
+        const auto          begin = nb.row_start[i];
+        const unsigned int  n     = nb.row_start[i + 1] - begin;
+        const std::int32_t *col   = nb.col.data() + begin;
+        const std::uint8_t *br    = brk.data() + begin;
+        const std::int32_t  lower = std::int32_t(i), owned = std::int32_t(n_owned);
+        const std::uint8_t  wi    = wf[i];
+        // First a branch-free (vectorizable) count of the critical bonds: a
+        // bond between owned nodes once (from its lower end), a bond to a
+        // ghost from both ranks (bitwise the same |y|^2), unbroken, with an
+        // end in Omega_w.
+        unsigned int count = 0;
+#pragma omp simd reduction(+ : count)
+        for (unsigned int b = 0; b < n; ++b)
           {
-            const std::int32_t j = nb.col[b];
-            // A bond between owned nodes once (from its lower end); a bond
-            // to a ghost from both ranks (bitwise the same |y|^2).
-            if ((j < std::int32_t(n_owned) && j < std::int32_t(i)) || brk[b] ||
-                (w[i] + w[j]) == 0.)
+            const std::int32_t j  = col[b];
+            const double      *pj = p + std::size_t(dim) * j;
+            double             l2 = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              l2 += (pj[d] - pi[d]) * (pj[d] - pi[d]);
+            const bool tested = (j > lower || j >= owned) && br[b] == 0 && (wi | wf[j]) != 0;
+            count += (tested && l2 >= L2[b]) ? 1u : 0u;
+          }
+        if (count == 0)
+          continue;
+        n_critical += count;
+        const double *B2 = breaking_length2.data() + nb.table_start[i];
+        for (unsigned int b = 0; b < n; ++b)
+          {
+            const std::int32_t j = col[b];
+            if ((j < owned && j < lower) || br[b] || (wi | wf[j]) == 0)
               continue;
             const double *pj = p + std::size_t(dim) * j;
             double        l2 = 0.;
             for (unsigned int d = 0; d < dim; ++d)
               l2 += (pj[d] - pi[d]) * (pj[d] - pi[d]);
-            if (l2 >= L2[b - begin])
+            if (l2 >= L2[b])
               {
-                ++n_critical;
                 crit[i] = 1.;
-                if (j < std::int32_t(n_owned))
+                if (j < owned)
                   crit[j] = 1.;
                 // Counted once per bond (a ghost bond by the end with the lower id).
-                if (l2 > B2[b - begin] &&
-                    (j < std::int32_t(n_owned) || disc.id[i] < disc.id[j]))
+                if (l2 > B2[b] && (j < owned || disc.id[i] < disc.id[j]))
                   ++overstretched;
               }
           }
@@ -203,30 +227,49 @@ namespace PeriDEAL
         const unsigned int  n     = nb.row_start[i + 1] - begin;
         const std::int32_t *col   = nb.col.data() + begin;
         std::uint8_t       *br    = flags.data() + begin;
-        double              f[dim] = {};
+        // Branch-free so that it vectorizes: a broken bond (or one that
+        // breaks now) contributes zero.
+        double        f0 = 0., f1 = 0., f2 = 0.;
+        unsigned int  n_break = 0;
+#pragma omp simd reduction(+ : f0, f1, f2, n_break)
         for (unsigned int b = 0; b < n; ++b)
           {
-            if (br[b])
-              continue;
             const double *pj = p + std::size_t(dim) * col[b];
-            double        y[dim];
+            double        y[3] = {0., 0., 0.};
             for (unsigned int d = 0; d < dim; ++d)
               y[d] = pj[d] - pi[d];
             double l2 = y[0] * y[0];
             for (unsigned int d = 1; d < dim; ++d)
               l2 = std::fma(y[d], y[d], l2);
-            const double l  = std::sqrt(l2);
-            const double dl = l - r[b];
-            if (dl > s0 * r[b])
-              {
-                br[b] = 1;
-                broke = true;
-                continue;
-              }
-            const double scale = k[b] * dl / l;
-            for (unsigned int d = 0; d < dim; ++d)
-              f[d] += scale * y[d];
+            const double l      = std::sqrt(l2);
+            const double dl     = l - r[b];
+            const bool   alive  = br[b] == 0;
+            const bool   breaks = alive && dl > s0 * r[b];
+            n_break += breaks ? 1u : 0u;
+            const double scale = (alive && !breaks) ? k[b] * dl / l : 0.;
+            f0 += scale * y[0];
+            f1 += scale * y[1];
+            f2 += scale * y[2];
           }
+        if (n_break > 0)
+          {
+            broke = true;
+            for (unsigned int b = 0; b < n; ++b)
+              if (br[b] == 0)
+                {
+                  const double *pj = p + std::size_t(dim) * col[b];
+                  double        l2 = 0.;
+                  double        y[dim];
+                  for (unsigned int d = 0; d < dim; ++d)
+                    y[d] = pj[d] - pi[d];
+                  l2 = y[0] * y[0];
+                  for (unsigned int d = 1; d < dim; ++d)
+                    l2 = std::fma(y[d], y[d], l2);
+                  if (std::sqrt(l2) - r[b] > s0 * r[b])
+                    br[b] = 1;
+                }
+          }
+        const double f[3] = {f0, f1, f2};
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
       }

@@ -219,6 +219,8 @@ namespace PeriDEAL
     std::vector<int> wls_row;
     /** 1 in Omega_w (local, with ghosts); critical end points (local, with ghosts). */
     Vector wls_flag, critical;
+    /** wls_flag as bytes (local, with ghosts), for the switching test. */
+    std::vector<std::uint8_t> wls_mask;
     /** Owned Omega_s rows; active WLS rows; owned rows with a bond touching Omega_w. */
     std::vector<unsigned int> standard_rows, active_wls_rows, test_rows;
     /** Per bond table entry: (r (1 + sigma s0))^2 and (r (1 + s0))^2. */
