@@ -15,6 +15,8 @@
 #               missing)
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
+#   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.5 --m 8";
+#               empty string: skip the Kalthoff-Winkler hybrid case)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -49,7 +51,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark kw_hybrid_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
@@ -272,6 +274,15 @@ EOF_LMP
 fi
 # EBF absorbing boundaries: ABC work as a fraction of the step time (serial).
 "$abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
+
+# Kalthoff-Winkler: standard vs adaptive hybrid (Table 3.3), serial.
+kw_hybrid_exe="$build/contrib/benchmarks/kw_hybrid_benchmark"
+kw_hybrid_args="${KW_HYBRID_ARGS---dx 0.5 --m 8}"
+if [ -n "$kw_hybrid_args" ] && [ -x "$kw_hybrid_exe" ]; then
+  # shellcheck disable=SC2086
+  ( cd "$build" && "$kw_hybrid_exe" $kw_hybrid_args --directory "$build/kw-hybrid-benchmark" ) \
+    | grep '^kw_' | tee -a "$results"
+fi
 
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"
 echo "run-all: results in $results" >&2

@@ -2,6 +2,7 @@
 #include <perideal/models/hybrid_bond_based.h>
 
 #include <chrono>
+#include <immintrin.h>
 #include <complex>
 #include <map>
 #include <cmath>
@@ -17,6 +18,185 @@ namespace PeriDEAL
     {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
+
+    /**
+     * |p_j - p_i|^2 of a bond, the same expression in every kernel below
+     * (y_0^2, then fused multiply-adds) so that the two copies of a bond,
+     * on one rank or two, and the switching test and the force see bitwise
+     * the same value.
+     */
+    template <int dim>
+    inline double
+    length2(const double *pj, const double *pi)
+    {
+      double l2 = (pj[0] - pi[0]) * (pj[0] - pi[0]);
+      for (unsigned int d = 1; d < dim; ++d)
+        l2 = std::fma(pj[d] - pi[d], pj[d] - pi[d], l2);
+      return l2;
+    }
+
+    /**
+     * Standard row (3.1) of the PMB force, portable: f = sum k (l - r) y / l
+     * over the unbroken bonds; bonds with l - r > s0 r break (flag set, no
+     * force). Returns the number of bonds broken now.
+     */
+    template <int dim>
+    unsigned int
+    pmb_row(const double       *p,
+            const double       *pi,
+            const std::int32_t *col,
+            const double       *k,
+            const double       *r,
+            std::uint8_t       *br,
+            const unsigned int  n,
+            const double        s0,
+            double             *f)
+    {
+      unsigned int n_break = 0;
+      for (unsigned int b = 0; b < n; ++b)
+        {
+          if (br[b])
+            continue;
+          const double *pj = p + std::size_t(dim) * col[b];
+          const double  l  = std::sqrt(length2<dim>(pj, pi));
+          const double  dl = l - r[b];
+          if (dl > s0 * r[b])
+            {
+              br[b] = 1;
+              ++n_break;
+              continue;
+            }
+          const double scale = k[b] * dl / l;
+          for (unsigned int d = 0; d < dim; ++d)
+            f[d] += scale * (pj[d] - pi[d]);
+        }
+      return n_break;
+    }
+
+    /**
+     * Switching test of one Omega_w row i, portable: the number of unbroken
+     * bonds b with |y|^2 >= L2[b] that this row tests: those to Omega_s
+     * nodes and to ghosts, and those to owned Omega_w nodes j > i (a bond
+     * between two owned Omega_w nodes is tested once). @p wf: 1 for Omega_w
+     * per local node.
+     */
+    template <int dim>
+    unsigned int
+    count_critical(const double       *p,
+                   const double       *pi,
+                   const std::int32_t *col,
+                   const double       *L2,
+                   const std::uint8_t *br,
+                   const unsigned int  n,
+                   const std::int32_t  i,
+                   const std::int32_t  n_owned,
+                   const std::int32_t *wf)
+    {
+      unsigned int count = 0;
+      for (unsigned int b = 0; b < n; ++b)
+        {
+          const std::int32_t j = col[b];
+          if ((j > i || j >= n_owned || wf[j] == 0) && br[b] == 0 &&
+              length2<dim>(p + std::size_t(dim) * j, pi) >= L2[b])
+            ++count;
+        }
+      return count;
+    }
+
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+    /** y = p_j - p_i of bonds b..b+7 (masked lanes read p_i itself). */
+    inline void
+    gather_y2(const double *p, const double *pi, const std::int32_t *col, const unsigned int b,
+              const __mmask8 m, __m512d &y0, __m512d &y1)
+    {
+      const __m256i j2 = _mm256_slli_epi32(_mm256_maskz_loadu_epi32(m, col + b), 1);
+      const __m512d x0 = _mm512_set1_pd(pi[0]), x1 = _mm512_set1_pd(pi[1]);
+      y0 = _mm512_sub_pd(_mm512_mask_i32gather_pd(x0, m, j2, p, 8), x0);
+      y1 = _mm512_sub_pd(_mm512_mask_i32gather_pd(x1, m, j2, p + 1, 8), x1);
+    }
+
+    /** pmb_row<2> with AVX-512: the same expressions, eight bonds at a time. */
+    unsigned int
+    pmb_row_avx512(const double       *p,
+                   const double       *pi,
+                   const std::int32_t *col,
+                   const double       *k,
+                   const double       *r,
+                   std::uint8_t       *br,
+                   const unsigned int  n,
+                   const double        s0,
+                   double             *f)
+    {
+      __m512d       a0 = _mm512_setzero_pd(), a1 = _mm512_setzero_pd();
+      const __m512d vs0     = _mm512_set1_pd(s0);
+      unsigned int  n_break = 0;
+      for (unsigned int b = 0; b < n; b += 8)
+        {
+          const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
+          const __mmask8 alive =
+            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128());
+          if (alive == 0)
+            continue;
+          __m512d y0, y1;
+          gather_y2(p, pi, col, b, alive, y0, y1);
+          const __m512d l2 =
+            _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.),
+                                 _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0)));
+          const __m512d  l   = _mm512_sqrt_pd(l2);
+          const __m512d  rb  = _mm512_maskz_loadu_pd(alive, r + b);
+          const __m512d  dl  = _mm512_sub_pd(l, rb);
+          const __mmask8 brk = _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
+          const __mmask8 live = alive & ~brk;
+          const __m512d  scale =
+            _mm512_maskz_div_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), l);
+          a0 = _mm512_fmadd_pd(scale, y0, a0);
+          a1 = _mm512_fmadd_pd(scale, y1, a1);
+          if (brk)
+            {
+              _mm_mask_storeu_epi8(br + b, brk, _mm_set1_epi8(1));
+              n_break += __builtin_popcount(brk);
+            }
+        }
+      f[0] += _mm512_reduce_add_pd(a0);
+      f[1] += _mm512_reduce_add_pd(a1);
+      return n_break;
+    }
+
+    /** count_critical<2> with AVX-512. */
+    unsigned int
+    count_critical_avx512(const double       *p,
+                          const double       *pi,
+                          const std::int32_t *col,
+                          const double       *L2,
+                          const std::uint8_t *br,
+                          const unsigned int  n,
+                          const std::int32_t  i,
+                          const std::int32_t  n_owned,
+                          const std::int32_t *wf)
+    {
+      unsigned int  count = 0;
+      const __m256i vi = _mm256_set1_epi32(i), vo = _mm256_set1_epi32(n_owned - 1);
+      const __m256i zero = _mm256_setzero_si256();
+      for (unsigned int b = 0; b < n; b += 8)
+        {
+          const __mmask8 m  = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
+          const __m256i  cj = _mm256_maskz_loadu_epi32(m, col + b);
+          const __m256i  wj = _mm256_mmask_i32gather_epi32(zero, m, cj, wf, 4);
+          const __mmask8 tested =
+            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128()) &
+            (_mm256_cmpgt_epi32_mask(cj, vi) | _mm256_cmpgt_epi32_mask(cj, vo) |
+             _mm256_cmpeq_epi32_mask(wj, zero));
+          if (tested == 0)
+            continue;
+          __m512d y0, y1;
+          gather_y2(p, pi, col, b, tested, y0, y1);
+          const __m512d l2 = _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0));
+          count += __builtin_popcount(
+            _mm512_mask_cmp_pd_mask(tested, l2, _mm512_maskz_loadu_pd(tested, L2 + b), _CMP_GE_OQ));
+        }
+      return count;
+    }
+#endif
   } // namespace
 
   template <int dim>
@@ -35,6 +215,8 @@ namespace PeriDEAL
                     "nonlinear PMB force with breaking)");
     check_parameter(prm.sigma > 0. && prm.sigma < 1., "Hybrid/Sigma", prm.sigma,
                     "a number in (0, 1)");
+    check_parameter(prm.check_interval >= 1, "Hybrid/Switching interval", prm.check_interval,
+                    "an integer >= 1");
     AssertThrow(standard.size() == disc.n_owned(),
                 ExcMessage("One Omega_s flag per owned node is needed."));
 
@@ -83,16 +265,10 @@ namespace PeriDEAL
       wls_mask[k] = wls_flag.local_element(k) > 0.5;
     standard_rows.clear();
     active_wls_rows.clear();
-    test_rows.clear();
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const bool w = wls_flag.local_element(i) > 0.5;
         (w ? active_wls_rows : standard_rows).push_back(i);
-        bool touches = w;
-        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !touches; ++b)
-          touches = wls_flag.local_element(nb.col[b]) > 0.5;
-        if (touches)
-          test_rows.push_back(i);
       }
   }
 
@@ -108,9 +284,12 @@ namespace PeriDEAL
     double            *crit    = critical.begin();
     const double      *p       = deformed.data();
     (void)u;
-    std::uint64_t n_critical = 0;
-    const std::uint8_t *wf = wls_mask.data();
-    for (const unsigned int i : test_rows)
+    std::uint64_t       n_critical = 0;
+    const std::int32_t *wf         = wls_mask.data();
+    const std::int32_t  owned      = std::int32_t(n_owned);
+    // Only the Omega_w rows test: every bond with an Omega_w end is tested
+    // in the row of such an end (owned by this or another rank).
+    for (const unsigned int i : active_wls_rows)
       {
         const double       *pi    = p + std::size_t(dim) * i;
         const double       *L2    = critical_length2.data() + nb.table_start[i];
@@ -118,24 +297,14 @@ namespace PeriDEAL
         const unsigned int  n     = nb.row_start[i + 1] - begin;
         const std::int32_t *col   = nb.col.data() + begin;
         const std::uint8_t *br    = brk.data() + begin;
-        const std::int32_t  lower = std::int32_t(i), owned = std::int32_t(n_owned);
-        const std::uint8_t  wi    = wf[i];
-        // First a branch-free (vectorizable) count of the critical bonds: a
-        // bond between owned nodes once (from its lower end), a bond to a
-        // ghost from both ranks (bitwise the same |y|^2), unbroken, with an
-        // end in Omega_w.
-        unsigned int count = 0;
-#pragma omp simd reduction(+ : count)
-        for (unsigned int b = 0; b < n; ++b)
-          {
-            const std::int32_t j  = col[b];
-            const double      *pj = p + std::size_t(dim) * j;
-            double             l2 = 0.;
-            for (unsigned int d = 0; d < dim; ++d)
-              l2 += (pj[d] - pi[d]) * (pj[d] - pi[d]);
-            const bool tested = (j > lower || j >= owned) && br[b] == 0 && (wi | wf[j]) != 0;
-            count += (tested && l2 >= L2[b]) ? 1u : 0u;
-          }
+        const std::int32_t  lower = std::int32_t(i);
+        unsigned int        count;
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+        if constexpr (dim == 2)
+          count = count_critical_avx512(p, pi, col, L2, br, n, lower, owned, wf);
+        else
+#endif
+          count = count_critical<dim>(p, pi, col, L2, br, n, lower, owned, wf);
         if (count == 0)
           continue;
         n_critical += count;
@@ -143,19 +312,17 @@ namespace PeriDEAL
         for (unsigned int b = 0; b < n; ++b)
           {
             const std::int32_t j = col[b];
-            if ((j < owned && j < lower) || br[b] || (wi | wf[j]) == 0)
+            if (!(j > lower || j >= owned || wf[j] == 0) || br[b])
               continue;
-            const double *pj = p + std::size_t(dim) * j;
-            double        l2 = 0.;
-            for (unsigned int d = 0; d < dim; ++d)
-              l2 += (pj[d] - pi[d]) * (pj[d] - pi[d]);
+            const double l2 = length2<dim>(p + std::size_t(dim) * j, pi);
             if (l2 >= L2[b])
               {
+                // Both end points, a ghost one too (sent to its owner below).
                 crit[i] = 1.;
-                if (j < owned)
-                  crit[j] = 1.;
-                // Counted once per bond (a ghost bond by the end with the lower id).
-                if (l2 > B2[b] && (j < owned || disc.id[i] < disc.id[j]))
+                crit[j] = 1.;
+                // Once per bond: a bond to an Omega_w ghost is tested on
+                // both ranks, counted by the end with the lower id.
+                if (l2 > B2[b] && (j < owned || wf[j] == 0 || disc.id[i] < disc.id[j]))
                   ++overstretched;
               }
           }
@@ -163,6 +330,7 @@ namespace PeriDEAL
     // One global sum per step; the ghost exchanges only when needed.
     if (Utilities::MPI::sum(n_critical, disc.get_mpi_communicator()) == 0)
       return false;
+    critical.compress(VectorOperation::add); // marks of ghost end points to their owners
     critical.update_ghost_values();
     bool changed = false;
     for (unsigned int i = 0; i < n_owned; ++i)
@@ -206,7 +374,8 @@ namespace PeriDEAL
         for (std::size_t i = 0; i < n_local; ++i)
           deformed[dim * i + d] = (x[i][d] - xc[d]) + ud[i];
       }
-    if (!test_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1)
+    if ((n_evaluations++ % prm.check_interval == 0) &&
+        (!active_wls_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1))
       switch_critical(u);
     seconds[0] += seconds_since(start);
 
@@ -227,49 +396,15 @@ namespace PeriDEAL
         const unsigned int  n     = nb.row_start[i + 1] - begin;
         const std::int32_t *col   = nb.col.data() + begin;
         std::uint8_t       *br    = flags.data() + begin;
-        // Branch-free so that it vectorizes: a broken bond (or one that
-        // breaks now) contributes zero.
-        double        f0 = 0., f1 = 0., f2 = 0.;
-        unsigned int  n_break = 0;
-#pragma omp simd reduction(+ : f0, f1, f2, n_break)
-        for (unsigned int b = 0; b < n; ++b)
-          {
-            const double *pj = p + std::size_t(dim) * col[b];
-            double        y[3] = {0., 0., 0.};
-            for (unsigned int d = 0; d < dim; ++d)
-              y[d] = pj[d] - pi[d];
-            double l2 = y[0] * y[0];
-            for (unsigned int d = 1; d < dim; ++d)
-              l2 = std::fma(y[d], y[d], l2);
-            const double l      = std::sqrt(l2);
-            const double dl     = l - r[b];
-            const bool   alive  = br[b] == 0;
-            const bool   breaks = alive && dl > s0 * r[b];
-            n_break += breaks ? 1u : 0u;
-            const double scale = (alive && !breaks) ? k[b] * dl / l : 0.;
-            f0 += scale * y[0];
-            f1 += scale * y[1];
-            f2 += scale * y[2];
-          }
-        if (n_break > 0)
-          {
-            broke = true;
-            for (unsigned int b = 0; b < n; ++b)
-              if (br[b] == 0)
-                {
-                  const double *pj = p + std::size_t(dim) * col[b];
-                  double        l2 = 0.;
-                  double        y[dim];
-                  for (unsigned int d = 0; d < dim; ++d)
-                    y[d] = pj[d] - pi[d];
-                  l2 = y[0] * y[0];
-                  for (unsigned int d = 1; d < dim; ++d)
-                    l2 = std::fma(y[d], y[d], l2);
-                  if (std::sqrt(l2) - r[b] > s0 * r[b])
-                    br[b] = 1;
-                }
-          }
-        const double f[3] = {f0, f1, f2};
+        double             f[dim] = {};
+        unsigned int       n_break;
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+        if constexpr (dim == 2)
+          n_break = pmb_row_avx512(p, pi, col, k, r, br, n, s0, f);
+        else
+#endif
+          n_break = pmb_row<dim>(p, pi, col, k, r, br, n, s0, f);
+        broke = broke || n_break > 0;
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
       }

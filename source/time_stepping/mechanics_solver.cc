@@ -186,6 +186,10 @@ namespace PeriDEAL
                       "force evaluation.");
     prm.declare_entry("Sigma", "0.95", Patterns::Double(),
                       "Margin sigma of the switching criterion (3.80), in (0, 1).");
+    prm.declare_entry("Switching interval", "1", Patterns::Integer(),
+                      "Test (3.80) every this many steps (>= 1; 1: every step as in the "
+                      "source). Bonds passing s0 in between are counted in the CSV column "
+                      "overstretched_bonds.");
     WlsParameters::declare_parameters(prm);
     prm.declare_entry("Boundary width", "1", Patterns::Double(),
                       "Initial Omega_s: interior nodes closer than this many horizons (>= 1: "
@@ -272,6 +276,10 @@ namespace PeriDEAL
     check_parameter(hybrid.sigma > 0. && hybrid.sigma < 1., "Mechanics/Hybrid/Sigma",
                     hybrid.sigma, "a number in (0, 1)");
     hybrid.wls.parse_parameters(p);
+    const long interval = p.get_integer("Switching interval");
+    check_parameter(interval >= 1, "Mechanics/Hybrid/Switching interval", interval,
+                    "an integer >= 1");
+    hybrid.check_interval = (unsigned int)interval;
     check_parameter(hybrid.wls.order == 2 || hybrid.wls.order == 4 ||
                       (dim == 1 && hybrid.wls.order == 6),
                     "Mechanics/Hybrid/Order", hybrid.wls.order,

@@ -370,6 +370,9 @@ namespace
     };
     auto p = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 1.5, "bad");
     expect([&] { solver(p); }, "Sigma");
+    p                       = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
+    p.hybrid.check_interval = 0;
+    expect([&] { solver(p); }, "Switching interval");
     p              = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
     p.model.linearized = true;
     expect([&] { solver(p); }, "Linearized");
