@@ -17,6 +17,8 @@
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
 #   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 10)
 #   KW_ARGS     options of kw_multiadaptive_benchmark (default: its CI-size case)
+#   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.5 --m 8";
+#               empty string: skip the Kalthoff-Winkler hybrid case)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
 
@@ -51,7 +53,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark kw_hybrid_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
@@ -285,6 +287,14 @@ kw_exe="$build/contrib/benchmarks/kw_multiadaptive_benchmark"
 if [ -x "$kw_exe" ]; then
   # shellcheck disable=SC2086
   "$kw_exe" ${KW_ARGS:-} | grep '^kw_' | tee -a "$results"
+fi
+# Kalthoff-Winkler: standard vs adaptive hybrid (Table 3.3), serial.
+kw_hybrid_exe="$build/contrib/benchmarks/kw_hybrid_benchmark"
+kw_hybrid_args="${KW_HYBRID_ARGS---dx 0.5 --m 8}"
+if [ -n "$kw_hybrid_args" ] && [ -x "$kw_hybrid_exe" ]; then
+  # shellcheck disable=SC2086
+  ( cd "$build" && "$kw_hybrid_exe" $kw_hybrid_args --directory "$build/kw-hybrid-benchmark" ) \
+    | grep '^kw_' | tee -a "$results"
 fi
 
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"

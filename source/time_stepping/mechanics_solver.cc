@@ -176,6 +176,31 @@ namespace PeriDEAL
                       "2D: segments 'x0, y0, x1, y1'; 3D: planar polygons 'x0, y0, z0, x1, "
                       "y1, z1, x2, y2, z2[, ...]'; separated by ';'. Bonds crossing them are "
                       "broken before the first step.");
+    prm.enter_subsection("Hybrid");
+    prm.declare_entry("Quadrature", "standard", Patterns::Selection("standard|hybrid adaptive"),
+                      "standard: the standard scheme (3.1) on every node. hybrid adaptive: "
+                      "the adaptive hybrid configuration of Sect. 3.3 (bond-based PMB only): "
+                      "standard scheme on Omega_s, WLS collocation of the linearized bond "
+                      "force on Omega_w; a bond of Omega_w with stretch >= Sigma s0 (3.80) "
+                      "moves the families of both its end nodes to Omega_s before the next "
+                      "force evaluation.");
+    prm.declare_entry("Sigma", "0.95", Patterns::Double(),
+                      "Margin sigma of the switching criterion (3.80), in (0, 1).");
+    prm.declare_entry("Switching interval", "1", Patterns::Integer(),
+                      "Test (3.80) every this many steps (>= 1; 1: every step as in the "
+                      "source). Bonds passing s0 in between are counted in the CSV column "
+                      "overstretched_bonds.");
+    WlsParameters::declare_parameters(prm);
+    prm.declare_entry("Boundary width", "1", Patterns::Double(),
+                      "Initial Omega_s: interior nodes closer than this many horizons (>= 1: "
+                      "the WLS rows assume a full horizon) to the boundary of the body.");
+    prm.declare_entry("Pre-crack width", "2", Patterns::Double(),
+                      "Initial Omega_s: nodes closer than this many horizons (>= 0) to a 2D "
+                      "pre-crack segment (must be 0 in 3D: use 'Standard region').");
+    prm.declare_entry("Standard region", "0", Patterns::Anything(),
+                      "Initial Omega_s also holds the nodes where this expression in x, y, z "
+                      "is > 0.");
+    prm.leave_subsection();
     prm.leave_subsection();
 
     prm.enter_subsection("Measurements");
@@ -245,6 +270,35 @@ namespace PeriDEAL
             polygon[k][d] = v[k * dim + d];
         precracks.push_back(polygon);
       }
+    p.enter_subsection("Hybrid");
+    quadrature = p.get("Quadrature");
+    hybrid.sigma = p.get_double("Sigma");
+    check_parameter(hybrid.sigma > 0. && hybrid.sigma < 1., "Mechanics/Hybrid/Sigma",
+                    hybrid.sigma, "a number in (0, 1)");
+    hybrid.wls.parse_parameters(p);
+    const long interval = p.get_integer("Switching interval");
+    check_parameter(interval >= 1, "Mechanics/Hybrid/Switching interval", interval,
+                    "an integer >= 1");
+    hybrid.check_interval = (unsigned int)interval;
+    check_parameter(hybrid.wls.order == 2 || hybrid.wls.order == 4 ||
+                      (dim == 1 && hybrid.wls.order == 6),
+                    "Mechanics/Hybrid/Order", hybrid.wls.order,
+                    dim == 1 ? "2, 4 or 6 in 1D" : "2 or 4 in 2D/3D");
+    boundary_width  = p.get_double("Boundary width");
+    precrack_width  = p.get_double("Pre-crack width");
+    standard_region = p.get("Standard region");
+    check_parameter(boundary_width >= 1., "Mechanics/Hybrid/Boundary width", boundary_width,
+                    "a number >= 1 (horizons)");
+    check_parameter(precrack_width >= 0. && (dim != 3 || precrack_width == 0. ||
+                                             quadrature == "standard"),
+                    "Mechanics/Hybrid/Pre-crack width", precrack_width,
+                    dim == 3 ? "0 in 3D (use 'Standard region')" : "a number >= 0 (horizons)");
+    check_parameter(quadrature == "standard" || model_type == "bond-based",
+                    "Mechanics/Hybrid/Quadrature", quadrature,
+                    "standard for the LPS model (hybrid adaptive is bond-based)");
+    check_parameter(quadrature == "standard" || !model.linearized, "Mechanics/Hybrid/Quadrature",
+                    quadrature, "standard for the linearized bond-based model");
+    p.leave_subsection();
     p.leave_subsection();
 
     p.enter_subsection("Measurements");
@@ -299,6 +353,44 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  std::vector<bool>
+  MechanicsSolver<dim>::initial_standard_region() const
+  {
+    const double delta = prm.lattice.delta;
+    check_parameter(prm.domain->has_signed_distance(), "Mechanics/Hybrid/Quadrature",
+                    prm.quadrature, "standard for a geometry without a signed distance");
+    FunctionParser<dim> region(1);
+    try
+      {
+        region.initialize(FunctionParser<dim>::default_variable_names(), prm.standard_region,
+                          expression_constants(dim));
+        region.value(Point<dim>());
+      }
+    catch (std::exception &)
+      {
+        throw ParameterError("Mechanics/Hybrid/Standard region", prm.standard_region,
+                             "a muparser expression in x, y, z");
+      }
+    std::vector<bool> standard(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const Point<dim> &x = disc.position[i];
+        bool s = prm.domain->signed_distance(x) > -prm.boundary_width * delta ||
+                 region.value(x) > 0.;
+        if constexpr (dim == 2)
+          for (const auto &crack : prm.precracks)
+            {
+              // Distance to the segment [a, b].
+              const Tensor<1, dim> ab = crack[1] - crack[0], ax = x - crack[0];
+              const double t = std::clamp(ab * ax / std::max(ab * ab, 1e-300), 0., 1.);
+              s = s || (ax - t * ab).norm() < prm.precrack_width * delta;
+            }
+        standard[i] = s;
+      }
+    return standard;
+  }
+
+  template <int dim>
   MechanicsSolver<dim>::MechanicsSolver(const MPI_Comm comm, const MechanicsRunParameters<dim> &p)
     : mpi_communicator(comm)
     , prm(p)
@@ -336,7 +428,15 @@ namespace PeriDEAL
         check_parameter(prm.model_type == "bond-based", "Mechanics/Model", prm.model_type,
                         "bond-based|LPS");
         bond_based = std::make_unique<BondBasedOperator<dim>>(disc, prm.model);
-        op         = make_mechanics_model(*bond_based);
+        if (prm.quadrature == "hybrid adaptive")
+          {
+            auto model = std::make_unique<HybridBondBasedModel<dim>>(
+              *bond_based, prm.model.omega, prm.hybrid, initial_standard_region());
+            hybrid = model.get();
+            op     = std::move(model);
+          }
+        else
+          op = make_mechanics_model(*bond_based);
       }
     for (const auto &crack : prm.precracks)
       op->add_precrack(crack);
@@ -557,6 +657,9 @@ namespace PeriDEAL
     if (prm.energy_radius > 0.)
       for (const char *name : {"circle_kinetic_energy", "circle_strain_energy", "circle_energy"})
         c.push_back(name);
+    if (prm.quadrature == "hybrid adaptive")
+      for (const char *name : {"standard_fraction", "overstretched_bonds"})
+        c.push_back(name);
     c.push_back("wall_time");
     return c;
   }
@@ -694,6 +797,8 @@ namespace PeriDEAL
     if (prm.energy_radius > 0.)
       row.insert(row.end(), {m.circle_kinetic_energy, m.circle_strain_energy,
                              m.circle_kinetic_energy + m.circle_strain_energy});
+    if (hybrid)
+      row.insert(row.end(), {hybrid->standard_fraction(), double(hybrid->n_overstretched_bonds())});
     row.push_back(wall_offset + wall.wall_time());
     csv->add_row(row);
     series_rows.push_back(row);
@@ -710,6 +815,8 @@ namespace PeriDEAL
         for (unsigned int d = 0; d < dim; ++d)
           fields.emplace_back(vnames[d], &verlet->velocity[d]);
         fields.emplace_back("damage", &damage);
+        if (hybrid) // 0 standard (Omega_s), 1 WLS (Omega_w)
+          fields.emplace_back("scheme", &hybrid->scheme());
         if (snapshot)
           vtu->write(verlet->time(), verlet->step(), fields);
         if (prm.write_node_table && verlet->step() == total_steps)

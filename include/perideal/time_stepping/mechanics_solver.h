@@ -8,6 +8,7 @@
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/domain.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/models/hybrid_bond_based.h>
 #include <perideal/models/lps.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
@@ -62,6 +63,20 @@ namespace PeriDEAL
     std::vector<Region> tractions;
     /** 2D pre-crack segments (a, b). */
     std::vector<std::vector<Point<dim>>> precracks;
+
+    /** @name Adaptive hybrid configuration (Mechanics/Hybrid, Sect. 3.3) */
+    /** @{ */
+    /** "standard" or "hybrid adaptive". */
+    std::string               quadrature = "standard";
+    HybridMechanicsParameters hybrid;
+    /**
+     * Initial Omega_s: interior nodes within boundary_width delta of the
+     * boundary, within precrack_width delta of a pre-crack segment (2D), or
+     * where the expression standard_region is > 0.
+     */
+    double      boundary_width = 1., precrack_width = 2.;
+    std::string standard_region = "0";
+    /** @} */
 
     /** @name Measurements */
     /** @{ */
@@ -184,6 +199,12 @@ namespace PeriDEAL
      */
     Tensor<1, dim>
     reaction_force(const unsigned int k) const;
+    /** The adaptive hybrid model, or nullptr for the standard scheme. */
+    const HybridBondBasedModel<dim> *
+    hybrid_model() const
+    {
+      return hybrid;
+    }
     /** Number of prescribed regions. */
     unsigned int
     n_prescribed_regions() const
@@ -215,6 +236,9 @@ namespace PeriDEAL
     /** @} */
 
   private:
+    /** Initial Omega_s of the adaptive hybrid configuration (per owned node). */
+    std::vector<bool>
+    initial_standard_region() const;
     std::string
     signature() const;
     void
@@ -233,6 +257,8 @@ namespace PeriDEAL
     std::unique_ptr<std::conditional_t<(dim >= 2), LinearizedLPSOperator<(dim >= 2 ? dim : 2)>, int>>
                                            lps;
     std::unique_ptr<MechanicsModel<dim>>   op;
+    /** op as the adaptive hybrid model (Quadrature = hybrid adaptive), else nullptr. */
+    HybridBondBasedModel<dim>             *hybrid = nullptr;
     std::unique_ptr<VelocityVerlet<dim>>    verlet;
     unsigned int                            total_steps = 0;
     std::uint64_t                           n_global_bonds = 0;

@@ -1,0 +1,246 @@
+#ifndef perideal_models_hybrid_bond_based_h
+#define perideal_models_hybrid_bond_based_h
+
+#include <perideal/discretization/wls_quadrature.h>
+#include <perideal/models/bond_based.h>
+#include <perideal/time_stepping/velocity_verlet.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace PeriDEAL
+{
+  /**
+   * Parameters of the adaptive hybrid configuration (dissertation Sect. 3.3)
+   * for bond-based fracture: the WLS quadrature of Omega_w and the margin
+   * sigma of the switching criterion (3.80).
+   */
+  struct HybridMechanicsParameters
+  {
+    /** WLS order and number of collocation nodes (WLS-2: 6 monomials, 29 nodes in 2D). */
+    WlsParameters wls;
+    /** Margin sigma in (0, 1) of (3.80): bonds of Omega_w with s >= sigma s0 are critical. */
+    double sigma = 0.95;
+    /**
+     * Test (3.80) every this many force evaluations (>= 1). 1 is (3.80) as
+     * stated; larger values trade the test's cost (about that of a force
+     * evaluation of the Omega_w rows) against the margin: bonds that pass s0
+     * in between are caught (and counted) at the next test.
+     */
+    unsigned int check_interval = 1;
+  };
+
+  /**
+   * The adaptive hybrid bond-based model of dissertation Sect. 3.3 behind
+   * the MechanicsModel interface.
+   *
+   * Nodes of Omega_s use the standard scheme (3.1): the nonlinear PMB bond
+   * force of every family bond with partial volumes and bond breaking (the
+   * BondBasedOperator's bond coefficients and critical stretch). Nodes of
+   * Omega_w use the meshfree WLS collocation quadrature of the linearized
+   * bond-based operator (3.52)-(3.59): F_i = sum_{c in C_i} W_ic u_c over
+   * n_c collocation nodes (WLS-2 in 2D: 6 monomials, 29 nodes). The
+   * dissertation derives WLS weights only for the linearized bond force
+   * (Sect. 3.2.2); a pairwise nonlinear force at the collocation nodes has
+   * no WLS weights (the weights act on the fitted displacement, not on
+   * bonds). Omega_w is, by construction, where every stretch is below
+   * sigma s0 ~ 1e-2, where the PMB force and its linearization differ by
+   * O(s) relative to the force (plus rotation terms that are small in
+   * KW-type problems). Bonds of Omega_w nodes never break.
+   *
+   * Switching (3.80): before each force evaluation (i.e. at the end of the
+   * previous step, at the new displacement) every unbroken bond with at
+   * least one end in Omega_w is tested; if s >= sigma s0 it is critical,
+   * and the union of the families of both end nodes moves to Omega_s for
+   * good (their new standard rows then break the bond in the same force
+   * evaluation if s > s0). Bonds found with s > s0 while still in Omega_w
+   * are counted (n_overstretched_bonds(); 0 means sigma was small enough).
+   * The test compares squared lengths with precomputed squared thresholds
+   * (no square root) and visits each bond between owned nodes once.
+   * Switching is rank independent: each rank marks the owned end points of
+   * its critical bonds (a bond to a ghost is tested on both ranks with
+   * bitwise the same length), one global sum tells whether anything is
+   * critical, and only then are the critical flags and the new schemes sent
+   * to the ghosts.
+   *
+   * The WLS rows of all initial Omega_w nodes are computed once at
+   * construction; a switched node just stops using its row. Damage,
+   * strain energy (bond energies (2.26) for every node, a diagnostic) and
+   * broken-bond bookkeeping are the BondBasedOperator's, whose flags are
+   * kept in sync.
+   */
+  template <int dim>
+  class HybridBondBasedModel : public MechanicsModel<dim>
+  {
+  public:
+    using VectorField = typename MechanicsModel<dim>::VectorField;
+
+    /**
+     * @p op provides c, s0, bond coefficients and broken flags (nonlinear
+     * PMB only: throws ParameterError for the linearized model); @p omega
+     * is its influence function (for the WLS operator rows).
+     * @p standard: per owned node, true if it starts in Omega_s; constrained
+     * (volume layer) nodes are always in Omega_s. Throws ParameterError if
+     * a WLS row cannot be built (family too small: widen Omega_s).
+     */
+    HybridBondBasedModel(BondBasedOperator<dim>          &op,
+                         const InfluenceFunction          omega,
+                         const HybridMechanicsParameters &parameters,
+                         const std::vector<bool>         &standard);
+
+    const Discretization<dim> &
+    discretization() const override
+    {
+      return disc;
+    }
+    void
+    initialize(VectorField &field) const override
+    {
+      op.initialize(field);
+    }
+    /** Switch (3.80) at @p u, then standard rows with breaking and WLS rows. */
+    void
+    compute_forces(const VectorField &u, VectorField &force) override;
+    void
+    strain_energy_density(const VectorField &u, Vector &W) const override
+    {
+      sync_broken_flags();
+      op.strain_energy_density(u, W);
+    }
+    double
+    total_strain_energy(const VectorField &u) const override
+    {
+      sync_broken_flags();
+      return op.total_strain_energy(u);
+    }
+    void
+    damage(Vector &phi) const override
+    {
+      sync_broken_flags();
+      op.damage(phi);
+    }
+    const std::vector<std::uint8_t> &
+    broken() const override
+    {
+      sync_broken_flags();
+      return op.broken();
+    }
+    void
+    set_broken_flags(const std::vector<std::uint8_t> &flags) override
+    {
+      op.set_broken_flags(flags);
+      broken_flag = flags;
+      op_stale    = false;
+    }
+    std::uint64_t
+    n_broken_bonds() const override
+    {
+      sync_broken_flags();
+      return op.n_broken_bonds();
+    }
+    void
+    add_precrack(const std::vector<Point<dim>> &polygon) override
+    {
+      sync_broken_flags();
+      op.add_precrack(polygon);
+      broken_flag = op.broken();
+    }
+    /**
+     * min of the standard bound (3.8) over all rows (any node may switch)
+     * and, over the WLS rows, the Gershgorin-type bound
+     * 2 sqrt(rho / sum_c ||W_ic||_inf) (Verlet is stable for
+     * dt <= 2 / sqrt(lambda_max)).
+     */
+    double
+    critical_time_step(const double rho) const override;
+    double
+    critical_stretch() const override
+    {
+      return op.critical_stretch();
+    }
+    std::string
+    description() const override;
+
+    /** @name Configuration */
+    /** @{ */
+    /** Per local node (owned, then ghosts): 1 Omega_w, 0 Omega_s (ghosts up to date). */
+    const Vector &
+    scheme() const
+    {
+      return wls_flag;
+    }
+    /** Global number of Omega_s nodes (interior and constrained). */
+    types::global_dof_index
+    n_standard_nodes() const;
+    /** Fraction of the nodes in Omega_s (global). */
+    double
+    standard_fraction() const
+    {
+      return double(n_standard_nodes()) / double(disc.n_global());
+    }
+    /** Global number of bonds found with s > s0 while in Omega_w (should be 0). */
+    std::uint64_t
+    n_overstretched_bonds() const;
+    /** Number of force evaluations at which some node switched (global). */
+    unsigned int
+    n_switch_events() const
+    {
+      return switch_events;
+    }
+    /** The WLS quadrature of the initial Omega_w rows. */
+    const WlsQuadrature<dim> &
+    wls_quadrature() const
+    {
+      return *wls;
+    }
+    /** Wall time [switching test, standard rows, WLS rows] of compute_forces() on this rank. */
+    std::array<double, 3> seconds{{0., 0., 0.}};
+    /** @} */
+
+  private:
+    /** Test (3.80) on the bonds touching Omega_w and switch; true if anything switched. */
+    bool
+    switch_critical(const VectorField &u);
+    /**
+     * Copy the broken flags to the BondBasedOperator if bonds broke since
+     * the last copy (lazily: damage and energies are read only for output).
+     */
+    void
+    sync_broken_flags() const
+    {
+      if (op_stale)
+        op.set_broken_flags(broken_flag);
+      op_stale = false;
+    }
+    /** Rebuild the row lists after a change of scheme. */
+    void
+    update_row_lists();
+
+    BondBasedOperator<dim>    &op;
+    const Discretization<dim> &disc;
+    HybridMechanicsParameters  prm;
+    double                     s0;
+    std::unique_ptr<WlsQuadrature<dim>> wls;
+    /** Per owned node: the WLS row index, or -1. */
+    std::vector<int> wls_row;
+    /** 1 in Omega_w (local, with ghosts); critical end points (local, with ghosts). */
+    Vector wls_flag, critical;
+    /** wls_flag as bytes (local, with ghosts), for the switching test. */
+    std::vector<std::int32_t> wls_mask;
+    /** Owned Omega_s rows; owned Omega_w rows. */
+    std::vector<unsigned int> standard_rows, active_wls_rows;
+    /** Per bond table entry: (r (1 + sigma s0))^2 and (r (1 + s0))^2. */
+    std::vector<double> critical_length2, breaking_length2;
+    /** Broken flags of the owned rows (op's copy is updated when a bond breaks). */
+    std::vector<std::uint8_t> broken_flag;
+    mutable bool              op_stale = false;
+    /** Scratch: deformed positions x - x_c + u, interleaved. */
+    std::vector<double> deformed;
+    std::uint64_t       overstretched = 0;
+    unsigned int        n_evaluations = 0;
+    unsigned int        switch_events = 0;
+  };
+} // namespace PeriDEAL
+
+#endif

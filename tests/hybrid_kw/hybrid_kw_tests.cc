@@ -1,0 +1,396 @@
+// Tests of the adaptive hybrid configuration (dissertation Sect. 3.3) for
+// bond-based fracture: standard PMB on Omega_s, WLS-2 collocation of the
+// linearized bond force on Omega_w, switching by (3.80).
+//  patch:     linear fields give zero force in the bulk and quadratic
+//             fields the closed-form PD force int c xi(x)xi/|xi|^3 u dV on
+//             the WLS nodes (WLS-2 is exact for quadratics);
+//  kw:        the Kalthoff-Winkler run at CI size against the uniform
+//             standard scheme (damage, crack length and angle; Omega_s grows
+//             only near the crack);
+//  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage;
+//  bad_input: ParameterError for bad Hybrid entries.
+
+#include <deal.II/base/mpi.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/discretization/discretization.h>
+#include <perideal/models/hybrid_bond_based.h>
+#include <perideal/time_stepping/mechanics_solver.h>
+
+#include "../check.h"
+
+#include <map>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  // (a) Patch test on a 40 x 40 box, dx = 1, delta = 4 (m = 4), E = 1,
+  // plane strain, no breaking. Omega_s = the band of width delta along the
+  // boundary plus the left half, so bulk nodes of both schemes exist.
+  void
+  patch()
+  {
+    LatticeParameters lp;
+    lp.dx            = 1.;
+    lp.delta         = 4.;
+    lp.cell_centered = true;
+    const double L = 40.;
+    Discretization<2> disc(MPI_COMM_WORLD);
+    disc.setup(BoxDomain<2>(Point<2>(0., 0.), Point<2>(L, L)), lp);
+    BondBasedModelParameters mp;
+    mp.plane_stress = false;
+    BondBasedOperator<2> op(disc, mp);
+    std::vector<bool>    standard(disc.n_owned());
+    const auto           boundary_distance = [&](const Point<2> &x) {
+      return std::min(std::min(x[0], L - x[0]), std::min(x[1], L - x[1]));
+    };
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      standard[i] = boundary_distance(disc.position[i]) < lp.delta || disc.position[i][0] < L / 2;
+    HybridMechanicsParameters hp;
+    HybridBondBasedModel<2>   model(op, InfluenceFunction::constant, hp, standard);
+    const double              c = op.micromodulus(), delta = lp.delta;
+
+    MechanicsModel<2>::VectorField u, f;
+    model.initialize(u);
+    model.initialize(f);
+    const auto evaluate = [&](const std::function<Tensor<1, 2>(const Point<2> &)> &field) {
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        for (unsigned int d = 0; d < 2; ++d)
+          u[d].local_element(i) = field(disc.position[i])[d];
+      for (auto &v : u)
+        v.update_ghost_values();
+      model.compute_forces(u, f);
+    };
+    // Bulk: the full family (delta + dx/2 with partial volumes) inside.
+    const auto bulk = [&](const unsigned int i) {
+      return boundary_distance(disc.position[i]) > delta + lp.dx;
+    };
+
+    // Linear field u = H x (stretch, shear and rotation): the PD force
+    // vanishes in the bulk. Scale: c |H| delta^3, the force of one half
+    // of a horizon.
+    const double H[2][2] = {{1e-3, 4e-4}, {-2e-4, 6e-4}};
+    evaluate([&](const Point<2> &x) {
+      return Tensor<1, 2>({H[0][0] * x[0] + H[0][1] * x[1], H[1][0] * x[0] + H[1][1] * x[1]});
+    });
+    const double scale = c * 1e-3 * std::pow(delta, 3);
+    double       max_f[2] = {0., 0.};
+    unsigned int n[2]     = {0, 0};
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (bulk(i))
+        {
+          const unsigned int s = model.scheme().local_element(i) > 0.5; // 1: WLS
+          ++n[s];
+          max_f[s] = std::max(max_f[s], std::hypot(f[0].local_element(i), f[1].local_element(i)));
+        }
+    for (unsigned int s = 0; s < 2; ++s)
+      {
+        max_f[s] = Utilities::MPI::max(max_f[s], MPI_COMM_WORLD);
+        n[s]     = Utilities::MPI::sum(n[s], MPI_COMM_WORLD);
+      }
+    check(n[0] > 50 && n[1] > 50, "bulk nodes: " + std::to_string(n[0]) + " standard, " +
+                                    std::to_string(n[1]) + " WLS");
+    // Round-off of sums of O(scale) terms (the WLS weights are O(c delta),
+    // with cancellation over 29 nodes; the PMB force cancels in +-xi pairs).
+    check(max_f[1] <= 1e-9 * scale, "linear field, WLS bulk nodes: max |F| = " + sci(max_f[1]) +
+                                      " <= 1e-9 c |H| delta^3 = " + sci(1e-9 * scale));
+    check(max_f[0] <= 1e-9 * scale, "linear field, standard bulk nodes: max |F| = " +
+                                      sci(max_f[0]) + " <= 1e-9 c |H| delta^3");
+
+    // Quadratic field u = (a x^2 / 2, b x^2 / 2): the linearized PD force
+    // over the full ball is, in polar coordinates (omega = 1),
+    // F_x = (c a / 2) int_0^delta r^2 dr int cos^4 = c a pi delta^3 / 8,
+    // F_y = (c b / 2) int_0^delta r^2 dr int cos^2 sin^2 = c b pi delta^3 / 24,
+    // independently of x. WLS-2 reproduces quadratics exactly, so the WLS
+    // nodes must match to round-off (relative to the x^2 values, which grow
+    // to L^2 = 1600 times the curvature term: tolerance 1e-8).
+    const double a = 2e-5, b = -3e-5;
+    evaluate([&](const Point<2> &x) {
+      return Tensor<1, 2>({0.5 * a * x[0] * x[0], 0.5 * b * x[0] * x[0]});
+    });
+    const double Fx = c * a * M_PI * std::pow(delta, 3) / 8.,
+                 Fy = c * b * M_PI * std::pow(delta, 3) / 24.;
+    double err[2] = {0., 0.};
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (bulk(i))
+        {
+          const unsigned int s = model.scheme().local_element(i) > 0.5;
+          err[s] = std::max(err[s], std::hypot(f[0].local_element(i) - Fx, f[1].local_element(i) - Fy));
+        }
+    for (double &e : err)
+      e = Utilities::MPI::max(e, MPI_COMM_WORLD) / std::hypot(Fx, Fy);
+    check(err[1] <= 1e-8, "quadratic field, WLS bulk nodes: max |F - F_exact| / |F_exact| = " +
+                            sci(err[1]) + " <= 1e-8");
+    // The standard scheme is only a quadrature of the same integral (partial
+    // volumes at m = 4, PMB nonlinearity O(strain)): printed, and bounded by
+    // the few-percent quadrature error known for m = 4.
+    check(err[0] <= 0.1, "quadratic field, standard bulk nodes (quadrature error): " +
+                           sci(err[0]) + " <= 0.1");
+  }
+
+  // The Kalthoff-Winkler setup of tutorial/step-4 (plate 100 x 200 mm,
+  // pre-cracks at y = +-25 from x = 0 to 50, v0 = 16.5 m/s between them,
+  // steel, G0 = 22.17 N/mm, plane strain, omega_0, cell-centred lattice).
+  MechanicsRunParameters<2>
+  kalthoff_winkler(const double dx, const double delta, const double end_time,
+                   const std::string &quadrature, const double sigma, const std::string &dir)
+  {
+    MechanicsRunParameters<2> p;
+    p.domain                 = std::make_shared<BoxDomain<2>>(Point<2>(0., -100.), Point<2>(100., 100.));
+    p.lattice.dx             = dx;
+    p.lattice.delta          = delta;
+    p.lattice.cell_centered  = true;
+    p.model.omega            = InfluenceFunction::constant;
+    p.model.youngs_modulus   = 190e3;
+    p.model.plane_stress     = false;
+    p.model.fracture_energy  = 22.17;
+    p.density                = 8e-9;
+    p.initial_velocity       = "0; 0";
+    p.body_force             = "0; 0";
+    typename MechanicsRunParameters<2>::Region v;
+    v.level_set = "max(x - " + std::to_string(dx) + ", abs(y) - 25)";
+    v.value     = "16.5e3; 0";
+    p.prescribed_velocities = {v};
+    p.precracks = {{Point<2>(-1., 25.), Point<2>(50., 25.)}, {Point<2>(-1., -25.), Point<2>(50., -25.)}};
+    p.measure_crack         = true;
+    p.crack_origin          = Point<2>(50., 25.);
+    p.crack_region          = "max(50 - x, 25 - y)";
+    p.crack_fit_min_radius  = delta;
+    p.crack_fit_max_radius  = 50.;
+    p.time_step             = 0.;
+    p.end_time              = end_time;
+    p.output_directory      = dir;
+    p.time_series_interval  = 1000000;
+    p.progress_interval     = 1e9;
+    p.quadrature            = quadrature;
+    p.hybrid.sigma          = sigma;
+    return p;
+  }
+
+  // Damage of the owned nodes keyed by node id.
+  std::map<types::particle_index, double>
+  damage_by_id(const MechanicsSolver<2> &s)
+  {
+    PeriDEAL::Vector phi;
+    s.discretization().initialize_vector(phi);
+    s.model().damage(phi);
+    std::map<types::particle_index, double> m;
+    for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
+      m[s.discretization().id[i]] = phi.local_element(i);
+    return m;
+  }
+
+  // (b) KW at CI size: dx = 1 mm, delta = 4 mm (m = 4, 20,000 nodes), to
+  // 87.5 us, the same time step for both (0.9 x the hybrid's bound, which
+  // is the smaller one). Serial.
+  void
+  kw()
+  {
+    const double dx = 1., delta = 4., T = 87.5e-6;
+    auto         ph = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-hybrid");
+    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph);
+    hybrid.setup();
+    auto ps      = kalthoff_winkler(dx, delta, T, "standard", 0.8, "kw-standard");
+    ps.time_step = hybrid.integrator().time_step();
+    MechanicsSolver<2> standard(MPI_COMM_SELF, ps);
+    const auto        &disc = hybrid.discretization();
+    const auto        *hm   = hybrid.hybrid_model();
+    std::vector<bool>  initial_wls(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      initial_wls[i] = hm->scheme().local_element(i) > 0.5;
+    const double initial_fraction = hm->standard_fraction();
+    hybrid.run();
+    standard.run();
+    const auto mh = hybrid.measure(), ms = standard.measure();
+    const auto dh = damage_by_id(hybrid), ds = damage_by_id(standard);
+    if (root())
+      std::cout << "  KW dx = 1, m = 4, " << disc.n_global() << " nodes, "
+                << hybrid.integrator().step() << " steps: Omega_s " << 100. * initial_fraction
+                << "% -> " << 100. * hm->standard_fraction() << "%, stepping "
+                << standard.stepping_wall_time() << " s (standard) / "
+                << hybrid.stepping_wall_time() << " s (hybrid); switch events "
+                << hm->n_switch_events() << "\n  crack angle " << ms.crack_angle << " / "
+                << mh.crack_angle << " deg, length " << ms.crack_length << " / "
+                << mh.crack_length << " mm, broken bonds " << standard.model().n_broken_bonds()
+                << " / " << hybrid.model().n_broken_bonds() << std::endl;
+
+    check(hm->n_overstretched_bonds() == 0,
+          "no bond exceeded s0 while in Omega_w (sigma = 0.8): " +
+            std::to_string(hm->n_overstretched_bonds()));
+    check(hm->standard_fraction() > initial_fraction && hm->n_switch_events() > 0,
+          "Omega_s grew with the crack");
+    // Damage maps: a node cracked (damage >= 0.35) in one run should have a
+    // cracked node of the other run within 2 dx (the suggested KW check of
+    // the source catalogue: crack positions within 2 dx). The two are
+    // different discretizations of Omega_w (WLS on the full ball vs partial
+    // volumes, linearized vs PMB force), so the crack bands differ in their
+    // flank nodes, which is what 2 dx allows.
+    std::vector<Point<2>> cracked[2];
+    // Away from the impacted and the far edge (2 delta): there the coarse
+    // (m = 4) standard run also damages the impacted column and spalls at
+    // the free edge (the source notes a secondary crack opposite the impact
+    // for its uniform coarse run only), which the hybrid does not.
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const double x = disc.position[i][0];
+        if (x < 2. * delta || x > 100. - 2. * delta)
+          continue;
+        if (ds.at(disc.id[i]) >= 0.35)
+          cracked[0].push_back(disc.position[i]);
+        if (dh.at(disc.id[i]) >= 0.35)
+          cracked[1].push_back(disc.position[i]);
+      }
+    unsigned int unmatched[2] = {0, 0};
+    for (unsigned int r = 0; r < 2; ++r)
+      for (const auto &x : cracked[r])
+        {
+          bool near = false;
+          for (const auto &y : cracked[1 - r])
+            near = near || x.distance(y) <= 2. * dx * (1. + 1e-12);
+          unmatched[r] += !near;
+        }
+    check(cracked[0].size() > 100 && unmatched[0] <= 0.03 * cracked[0].size() &&
+            unmatched[1] <= 0.03 * cracked[1].size(),
+          "damage maps: " + std::to_string(unmatched[0]) + " of " +
+            std::to_string(cracked[0].size()) + " cracked nodes (standard) and " +
+            std::to_string(unmatched[1]) + " of " + std::to_string(cracked[1].size()) +
+            " (hybrid) farther than 2 dx from a cracked node of the other run (<= 3%)");
+    check_close(double(hybrid.model().n_broken_bonds()), double(standard.model().n_broken_bonds()),
+                0.05, "broken bonds (5%: the crack band, same reason)");
+    check_close(mh.crack_length, ms.crack_length, 0., "crack length (within 2 dx)", 2. * dx);
+    // The crack angle fits a line to a band 2-3 nodes wide over 25-50 mm
+    // (6-12 mm of which at dx = 2 are near the tip): a one-node shift of the
+    // far end moves it by ~atan(2/30) = 4 deg; allow 6 deg (the source
+    // shows agreement of the maps only graphically).
+    check_close(mh.crack_angle, ms.crack_angle, 0., "crack angle (6 deg)", 6.);
+
+    // Omega_s grows only near fracture: every switched node lies within
+    // 2 delta of a node damaged (> 0) in the hybrid or in the standard run.
+    // (3.80) switches at sigma s0 = 0.8 s0, so tension that nearly breaks
+    // bonds (the reflection from the far edge, where the coarse standard run
+    // spalls) switches too; anything farther would be a spurious switch.
+    std::vector<Point<2>> damaged;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (dh.at(disc.id[i]) > 0. || ds.at(disc.id[i]) > 0.)
+        damaged.push_back(disc.position[i]);
+    unsigned int far = 0, beyond = 0, switched = 0;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (initial_wls[i] && hm->scheme().local_element(i) < 0.5)
+        {
+          ++switched;
+          double dmin = 1e300;
+          for (const auto &q : damaged)
+            dmin = std::min(dmin, q.distance(disc.position[i]));
+          far += dmin > 2. * delta;
+          beyond += dmin > 3. * delta;
+        }
+    // Measured: 10 of 3490 switched nodes lie 2-2.3 delta from damage, next
+    // to the far-edge tension zone; none beyond 3 delta.
+    check(switched > 0 && far <= 0.01 * switched && beyond == 0,
+          std::to_string(switched) + " switched nodes, " + std::to_string(far) +
+            " farther than 2 delta from damage in either run (<= 1%), " + std::to_string(beyond) +
+            " farther than 3 delta (none)");
+  }
+
+  // (c) The same run to 50 us on MPI_COMM_WORLD and on rank 0 alone: the
+  // same Omega_s and the same damage per node.
+  void
+  rank_invariance()
+  {
+    const double dx = 2., delta = 8., T = 50e-6;
+    MechanicsSolver<2> dist(MPI_COMM_WORLD,
+                            kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "ri-dist"));
+    dist.run();
+    // (id, damage, scheme) of every node, gathered on rank 0.
+    std::vector<double> mine;
+    const auto          dd = damage_by_id(dist);
+    for (unsigned int i = 0; i < dist.discretization().n_owned(); ++i)
+      {
+        const auto id = dist.discretization().id[i];
+        mine.insert(mine.end(),
+                    {double(id), dd.at(id), dist.hybrid_model()->scheme().local_element(i)});
+      }
+    const auto   all = Utilities::MPI::gather(MPI_COMM_WORLD, mine, 0);
+    const auto   n_standard = dist.hybrid_model()->n_standard_nodes();
+    const auto   n_broken   = dist.model().n_broken_bonds();
+    const auto   events     = dist.hybrid_model()->n_switch_events();
+    if (!root())
+      return;
+    MechanicsSolver<2> serial(MPI_COMM_SELF,
+                              kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "ri-serial"));
+    serial.run();
+    check(events > 0 && n_standard == serial.hybrid_model()->n_standard_nodes(),
+          "Omega_s nodes: " + std::to_string(n_standard) + " (distributed, " +
+            std::to_string(events) + " switch events) = " +
+            std::to_string(serial.hybrid_model()->n_standard_nodes()) + " (serial)");
+    check(n_broken == serial.model().n_broken_bonds() && n_broken > 0,
+          "broken bonds: " + std::to_string(n_broken) + " = " +
+            std::to_string(serial.model().n_broken_bonds()));
+    const auto ds = damage_by_id(serial);
+    std::map<types::particle_index, double> serial_scheme;
+    for (unsigned int i = 0; i < serial.discretization().n_owned(); ++i)
+      serial_scheme[serial.discretization().id[i]] =
+        serial.hybrid_model()->scheme().local_element(i);
+    double       diff = 0.;
+    unsigned int scheme_diff = 0, n = 0;
+    for (const auto &part : all)
+      for (std::size_t k = 0; k < part.size(); k += 3, ++n)
+        {
+          const auto id = types::particle_index(part[k]);
+          diff          = std::max(diff, std::abs(part[k + 1] - ds.at(id)));
+          scheme_diff += part[k + 2] != serial_scheme.at(id);
+        }
+    check(n == serial.discretization().n_global(), "every node compared");
+    check(scheme_diff == 0, "scheme per node identical (" + std::to_string(scheme_diff) + " differ)");
+    // Same bonds broken (bitwise the same stretches): identical damage.
+    check(diff == 0., "max |damage_dist - damage_serial| = " + sci(diff));
+  }
+
+  void
+  bad_input()
+  {
+    const auto expect = [](const std::function<void()> &f, const std::string &name) {
+      bool thrown = false;
+      try
+        {
+          f();
+        }
+      catch (const ParameterError &e)
+        {
+          thrown = std::string(e.what()).find(name) != std::string::npos;
+        }
+      check(thrown, "ParameterError naming '" + name + "'");
+    };
+    const auto solver = [](const MechanicsRunParameters<2> &p) {
+      MechanicsSolver<2> s(MPI_COMM_SELF, p);
+      s.setup();
+    };
+    auto p = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 1.5, "bad");
+    expect([&] { solver(p); }, "Sigma");
+    p                       = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
+    p.hybrid.check_interval = 0;
+    expect([&] { solver(p); }, "Switching interval");
+    p              = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
+    p.model.linearized = true;
+    expect([&] { solver(p); }, "Linearized");
+    p                 = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
+    p.standard_region = "x +";
+    expect([&] { solver(p); }, "Standard region");
+    // m = 2: fewer than 29 nodes in a horizon.
+    p = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
+    expect([&] { solver(p); }, "collocation");
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv,
+             {{"patch", patch},
+              {"kw", kw},
+              {"rank_invariance", rank_invariance},
+              {"bad_input", bad_input}});
+}

@@ -1,0 +1,9 @@
+# Adaptive hybrid configuration (dissertation Sect. 3.3) for bond-based
+# fracture: patch test, Kalthoff-Winkler at CI size against the standard
+# scheme, rank invariance, bad input (one executable).
+perideal_add_test_program(hybrid_kw_tests ${CMAKE_CURRENT_LIST_DIR}/hybrid_kw_tests.cc)
+foreach(_t patch kw bad_input)
+  perideal_add_test(NAME hybrid_kw.${_t} COMMAND $<TARGET_FILE:hybrid_kw_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME hybrid_kw.rank_invariance.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:hybrid_kw_tests> rank_invariance LABELS "unit;mpi")
