@@ -282,6 +282,17 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  bool
+  BondBasedOperator<dim>::lattice_sweep_compiled()
+  {
+#ifdef PERIDEAL_PMB_AVX512
+    return dim > 1;
+#else
+    return false;
+#endif
+  }
+
+  template <int dim>
   void
   BondBasedOperator<dim>::setup_lattice_sweep()
   {

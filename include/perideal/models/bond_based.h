@@ -228,6 +228,10 @@ namespace PeriDEAL
       return sweep_available;
     }
 
+    /** True if the library was compiled with the AVX-512 sweep kernel. */
+    static bool
+    lattice_sweep_compiled();
+
     /** True if compute_forces() currently runs the lattice sweep. */
     bool
     uses_lattice_sweep() const
