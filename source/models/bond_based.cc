@@ -688,59 +688,86 @@ namespace PeriDEAL
     }
 
     /**
-     * One positive stencil offset of the lattice sweep over the box
-     * positions [c0, c0 + n) (n a multiple of 8, c0 too): bond (L, L + o)
-     * for every live bit (h, L). p and reaction are dim arrays of stride N
-     * over the box positions; the force on L is accumulated in a (the
-     * chunk's buffer, dim arrays of stride C), the reaction of node L + o in
-     * reaction (F = a - reaction). Newly broken bonds clear their bit and are
-     * appended to @p broken as (h, L).
+     * NO positive stencil offsets hs[0], ... of the lattice sweep over the
+     * box positions [c0, c0 + n) (n and c0 multiples of 8): bond
+     * (L, L + o_q) for every live bit (hs[q], L). p and reaction are
+     * dim arrays of stride N over the box positions; the force on L is
+     * accumulated in a (the chunk's buffer, dim arrays of stride C), the
+     * reaction of node L + o in reaction (F = a - reaction). The offsets
+     * share the loads of p_L and the update of a; they must lie more than
+     * 8 apart (else the reaction update of one partially overlaps the
+     * other's, and the store cannot be forwarded). Newly broken bonds clear
+     * their bit and are appended to @p broken as (h, L).
      */
-    template <int dim>
+    template <int dim, int NO>
     inline void
-    sweep_offset_avx512(const double  *p,
-                        double        *reaction,
-                        double        *a,
-                        std::uint8_t  *bits,
-                        const std::size_t N,
-                        const unsigned int C,
-                        const std::size_t c0,
-                        const unsigned int n,
-                        const std::int64_t o,
-                        const unsigned int h,
-                        const double       k,
-                        const double       r,
-                        const double       s0,
-                        std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
+    sweep_offsets_avx512(const double       *p,
+                         double             *reaction,
+                         double             *a,
+                         std::uint8_t       *live,
+                         const std::size_t   n_bytes,
+                         const std::size_t   N,
+                         const unsigned int  C,
+                         const std::size_t   c0,
+                         const unsigned int  n,
+                         const std::int64_t *o,
+                         const unsigned int *hs,
+                         const double       *k,
+                         const double       *r,
+                         const double        s0,
+                         std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
     {
-      const __m512d vk = _mm512_set1_pd(k), vr = _mm512_set1_pd(r), vs0 = _mm512_set1_pd(s0);
+      std::uint8_t *bits[NO];
+      __m512d       vk[NO], vr[NO];
+      for (int q = 0; q < NO; ++q)
+        {
+          bits[q] = live + hs[q] * n_bytes + c0 / 8;
+          vk[q]   = _mm512_set1_pd(k[hs[q]]);
+          vr[q]   = _mm512_set1_pd(r[hs[q]]);
+        }
+      const __m512d vs0 = _mm512_set1_pd(s0);
       for (unsigned int v = 0; v < n; v += 8)
         {
-          const __mmask8 alive = bits[v / 8];
-          if (alive == 0)
+          __mmask8 alive[NO], any = 0;
+          for (int q = 0; q < NO; ++q)
+            any |= alive[q] = bits[q][v / 8];
+          if (any == 0)
             continue;
           const std::size_t L = c0 + v;
-          __m512d           y[dim];
-          for (unsigned int d = 0; d < dim; ++d)
-            y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o), _mm512_loadu_pd(p + d * N + L));
-          __m512d l2 = _mm512_mul_pd(y[0], y[0]);
-          for (unsigned int d = 1; d < dim; ++d)
-            l2 = _mm512_fmadd_pd(y[d], y[d], l2);
-          __mmask8      brk;
-          const __m512d scale = pmb_bond_scale(l2, alive, vr, vk, vs0, brk);
+          __m512d           pi[dim], acc[dim];
           for (unsigned int d = 0; d < dim; ++d)
             {
-              double *ad = a + d * C + v, *rd = reaction + d * N + L + o;
-              _mm512_store_pd(ad, _mm512_fmadd_pd(scale, y[d], _mm512_load_pd(ad)));
-              _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
+              pi[d]  = _mm512_loadu_pd(p + d * N + L);
+              acc[d] = _mm512_load_pd(a + d * C + v);
             }
-          if (brk)
+          for (int q = 0; q < NO; ++q)
             {
-              bits[v / 8] = alive & ~brk;
-              for (unsigned int q = 0; q < 8; ++q)
-                if ((brk >> q) & 1u)
-                  broken.emplace_back(h, std::uint32_t(L + q));
+              if (alive[q] == 0)
+                continue;
+              __m512d y[dim];
+              for (unsigned int d = 0; d < dim; ++d)
+                y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
+              __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+              for (unsigned int d = 1; d < dim; ++d)
+                l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+              __mmask8      brk;
+              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0, brk);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  double *rd = reaction + d * N + L + o[hs[q]];
+                  acc[d]     = _mm512_fmadd_pd(scale, y[d], acc[d]);
+                  _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
+                }
+              if (brk)
+                {
+                  bits[q][v / 8] = alive[q] & ~brk;
+                  for (unsigned int l = 0; l < 8; ++l)
+                    if ((brk >> l) & 1u)
+                      broken.emplace_back(hs[q], std::uint32_t(L + l));
+                }
             }
+          for (unsigned int d = 0; d < dim; ++d)
+            _mm512_store_pd(a + d * C + v, acc[d]);
         }
     }
 
@@ -978,10 +1005,23 @@ namespace PeriDEAL
           std::fill(R + d * N + zeroed, R + d * N + need, 0.);
         zeroed = std::max(zeroed, need);
         std::fill(a, a + dim * C, 0.);
-        for (unsigned int h = 0; h < sweep_offset.size(); ++h)
-          sweep_offset_avx512<dim>(sweep_p.data(), R, a,
-                                   sweep_live.data() + h * sweep_n_bytes + c0 / 8, N, C, c0, n,
-                                   sweep_offset[h], h, sweep_k[h], sweep_r[h], s0, sweep_broken);
+        // Two offsets per pass (shared p_L loads and force updates): h and
+        // h + n_pairs, which lie in different lattice lines.
+        const unsigned int n_half = sweep_offset.size(), n_pairs = n_half / 2;
+        for (unsigned int h = 0; h < n_pairs; ++h)
+          {
+            const unsigned int hs[2] = {h, h + n_pairs};
+            sweep_offsets_avx512<dim, 2>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
+                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
+                                         sweep_r.data(), s0, sweep_broken);
+          }
+        if (n_half % 2)
+          {
+            const unsigned int hs[1] = {n_half - 1};
+            sweep_offsets_avx512<dim, 1>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
+                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
+                                         sweep_r.data(), s0, sweep_broken);
+          }
         const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
         for (std::size_t L = c0; L < c1; ++L)
           {
