@@ -163,10 +163,8 @@ namespace PeriDEAL
      * bonds whose stretch now exceeds s0 (their force is already zero).
      * @p u must have up-to-date ghost values.
      *
-     * By default the lattice sweep is used where available
-     * (set_lattice_sweep()); otherwise, in 1D and 2D every bond copy is
-     * evaluated in its own row (full list). With the half list (the 3D
-     * fallback, set_half_list()) a bond between two owned nodes is
+     * In 1D and 2D every bond copy is evaluated in its own row (full list)
+     * by default. With the half list (the 3D default, set_half_list()) a bond between two owned nodes is
      * evaluated once, in the row of the end point from which its lattice
      * offset is lexicographically positive, and its force is added to that
      * end and subtracted from the other (Newton's third law; valid because
