@@ -225,38 +225,63 @@ namespace
 
     // compute_forces alone (the state keeps evolving between the chunks
     // of the loop above; here u is frozen).
-    // The half list (the 3D default) and the full list (the 2D default: every bond
-    // copy evaluated in its own row) are timed round robin, three rounds,
-    // best of each: the machine is shared. Both count the same bond
-    // updates (bonds = both copies of every bond), so the ratio is the
-    // speed-up of the half list.
-    typename BondBasedOperator<dim>::VectorField force, force_full; // half, full list
+    // The lattice sweep (the default where available), the half list and
+    // the full list (every bond copy evaluated in its own row) are timed
+    // round robin, five rounds; per loop the best round and, per round, the
+    // CPU-time ratios to the full list (min and median printed): the
+    // machine is shared. All count the same bond updates (bonds = both
+    // copies of every bond), so the ratios are speed-ups.
+    typename BondBasedOperator<dim>::VectorField force, force_full, force_sweep; // half, full, sweep
     model.initialize(force);
     model.initialize(force_full);
-    Timing t_force, t_full; // half, full list
-    t_force.wall = t_force.cpu = t_full.wall = t_full.cpu = 1e300;
-    for (unsigned int round = 0; round < 3; ++round)
-      for (const bool half : {true, false})
-        {
-          model.set_half_list(half);
-          auto &out = half ? force : force_full;
-          const Timing t =
-            time_loop(comm, steps, [&] { model.compute_forces(verlet.displacement, out); });
-          Timing &best = half ? t_force : t_full;
-          best.wall    = std::min(best.wall, t.wall);
-          best.cpu     = std::min(best.cpu, t.cpu);
-        }
+    model.initialize(force_sweep);
+    const bool sweep_available = model.lattice_sweep_available();
+    Timing     t_force, t_full, t_sweep; // half, full list, sweep
+    t_force.wall = t_force.cpu = t_full.wall = t_full.cpu = t_sweep.wall = t_sweep.cpu = 1e300;
+    std::vector<double> half_ratio, sweep_ratio; // per round: cpu(full) / cpu(loop)
+    for (unsigned int round = 0; round < 5; ++round)
+      {
+        double cpu[3] = {0., 0., 0.};
+        for (const int loop : {2, 1, 0}) // sweep, half, full
+          {
+            if (loop == 2 && !sweep_available)
+              continue;
+            if (loop == 2)
+              model.set_lattice_sweep(true);
+            else
+              model.set_half_list(loop == 1);
+            auto &out = loop == 2 ? force_sweep : loop == 1 ? force : force_full;
+            const Timing t =
+              time_loop(comm, steps, [&] { model.compute_forces(verlet.displacement, out); });
+            Timing &best = loop == 2 ? t_sweep : loop == 1 ? t_force : t_full;
+            best.wall    = std::min(best.wall, t.wall);
+            best.cpu     = std::min(best.cpu, t.cpu);
+            cpu[loop]    = t.cpu;
+          }
+        half_ratio.push_back(cpu[0] / cpu[1]);
+        if (sweep_available)
+          sweep_ratio.push_back(cpu[0] / cpu[2]);
+      }
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v.empty() ? 0. : v[v.size() / 2];
+    };
     model.set_half_list(dim == 3);
-    double diff = 0., fmax = 0.;
+    model.set_lattice_sweep(true); // the library default
+    double diff = 0., diff_sweep = 0., fmax = 0.;
     for (unsigned int d = 0; d < dim; ++d)
       for (unsigned int i = 0; i < disc->n_owned(); ++i)
         {
           diff = std::max(diff, std::abs(force[d].local_element(i) - force_full[d].local_element(i)));
+          diff_sweep = std::max(diff_sweep, std::abs(force_sweep[d].local_element(i) -
+                                                     force_full[d].local_element(i)));
           fmax = std::max(fmax, std::abs(force_full[d].local_element(i)));
         }
-    diff = Utilities::MPI::max(diff, comm);
-    fmax = Utilities::MPI::max(fmax, comm);
-    const Timing &t_default = dim == 3 ? t_force : t_full; // the library's default loop
+    diff       = Utilities::MPI::max(diff, comm);
+    diff_sweep = Utilities::MPI::max(diff_sweep, comm);
+    fmax       = Utilities::MPI::max(fmax, comm);
+    // The library's default loop.
+    const Timing &t_default = sweep_available ? t_sweep : dim == 3 ? t_force : t_full;
     print("force_seconds", t_default.wall / steps);
     print("force_bond_updates_per_s_per_core", bond_updates / (t_default.wall * n_ranks));
     print("force_bond_updates_per_cpu_second", bond_updates / t_default.cpu);
@@ -265,6 +290,18 @@ namespace
     print("force_half_list_bond_updates_per_s_per_core", bond_updates / (t_force.wall * n_ranks));
     print("force_half_list_bond_updates_per_cpu_second", bond_updates / t_force.cpu);
     print("force_half_list_speedup_cpu", t_full.cpu / t_force.cpu);
+    print("force_half_list_speedup_cpu_min", *std::min_element(half_ratio.begin(), half_ratio.end()));
+    print("force_half_list_speedup_cpu_median", median(half_ratio));
+    print_exact("force_lattice_sweep_available", sweep_available);
+    if (sweep_available)
+      {
+        print("force_sweep_bond_updates_per_s_per_core", bond_updates / (t_sweep.wall * n_ranks));
+        print("force_sweep_bond_updates_per_cpu_second", bond_updates / t_sweep.cpu);
+        print("force_sweep_speedup_cpu", t_full.cpu / t_sweep.cpu);
+        print("force_sweep_speedup_cpu_min", *std::min_element(sweep_ratio.begin(), sweep_ratio.end()));
+        print("force_sweep_speedup_cpu_median", median(sweep_ratio));
+        print("force_sweep_full_max_difference_over_max_force", diff_sweep / fmax);
+      }
     print("force_half_full_max_difference_over_max_force", diff / fmax);
     flush();
   }

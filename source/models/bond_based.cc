@@ -155,6 +155,7 @@ namespace PeriDEAL
       }
     broken_flag.assign(nb.n_bonds(), 0);
     setup_half_list();
+    setup_lattice_sweep();
   }
 
   template <int dim>
@@ -261,6 +262,181 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  std::uint64_t
+  BondBasedOperator<dim>::find_bond(const unsigned int i, const unsigned int target) const
+  {
+    // A row lists its bonds in increasing stencil-box index.
+    const auto   &nb = disc.neighborhood;
+    std::uint64_t lo = nb.row_start[i], hi = nb.row_start[i + 1];
+    while (lo < hi)
+      {
+        const std::uint64_t mid = (lo + hi) / 2;
+        if (box_index(i, mid) < target)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+    AssertThrow(lo < nb.row_start[i + 1] && box_index(i, lo) == target,
+                ExcInternalError("A bond of the lattice sweep is missing in its row."));
+    return lo;
+  }
+
+  template <int dim>
+  bool
+  BondBasedOperator<dim>::lattice_sweep_compiled()
+  {
+#ifdef PERIDEAL_PMB_AVX512
+    return dim > 1;
+#else
+    return false;
+#endif
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::setup_lattice_sweep()
+  {
+    sweep_available = false;
+#ifdef PERIDEAL_PMB_AVX512
+    const auto        &nb      = disc.neighborhood;
+    const std::size_t  n_local = disc.position.size();
+    const unsigned int n_owned = disc.n_owned();
+    if (dim == 1 || linearized || n_owned == 0 || disc.lattice_index.size() != n_local)
+      return;
+    // The box of the local lattice positions; every extent at least 2M+1 so
+    // that a lexicographically positive offset has a positive linear offset.
+    std::array<int, dim> upper;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        sweep_lower[d] = std::numeric_limits<int>::max();
+        upper[d]       = std::numeric_limits<int>::min();
+      }
+    for (const auto &li : disc.lattice_index)
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          sweep_lower[d] = std::min(sweep_lower[d], li[d]);
+          upper[d]       = std::max(upper[d], li[d]);
+        }
+    std::int64_t n_box = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        sweep_stride[d] = n_box;
+        n_box *= std::max<std::int64_t>(upper[d] - sweep_lower[d] + 1, 2 * box_radius + 1);
+      }
+    if (n_box > 8 * std::int64_t(n_local) + 4096 || n_box > (std::int64_t(1) << 30))
+      return;
+
+    // The positive stencil offsets (box index above the centre).
+    const int          W      = 2 * box_radius + 1;
+    const unsigned int centre = centre_index();
+    sweep_half_of_box.assign(2 * centre + 1, -1);
+    sweep_offset.clear();
+    sweep_box_index.clear();
+    for (unsigned int q = centre + 1; q <= 2 * centre; ++q)
+      {
+        std::int64_t o = 0;
+        unsigned int rest = q;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            o += std::int64_t(int(rest % W) - box_radius) * sweep_stride[d];
+            rest /= W;
+          }
+        Assert(o > 0, ExcInternalError());
+        sweep_half_of_box[q] = sweep_half_of_box[2 * centre - q] = sweep_offset.size();
+        sweep_offset.push_back(o);
+        sweep_box_index.push_back(q);
+      }
+    const std::size_t n_half = sweep_offset.size();
+    sweep_k.assign(n_half, std::numeric_limits<double>::quiet_NaN());
+    sweep_r.assign(n_half, std::numeric_limits<double>::quiet_NaN());
+
+    // Every bond of an offset must have the same stiffness and length (and
+    // both copies of a bond the same: the offset and its negation share h).
+    std::vector<bool> seen(n_half, false);
+    const auto        uniform = [&](const unsigned int h, const std::uint64_t t) {
+      if (!seen[h])
+        {
+          seen[h]    = true;
+          sweep_k[h] = bond_coefficient[t];
+          sweep_r[h] = nb.bond_length[t];
+          return true;
+        }
+      return sweep_k[h] == bond_coefficient[t] && sweep_r[h] == nb.bond_length[t];
+    };
+    // Regular rows share the stencil table: check its slots once.
+    std::vector<bool> table_checked;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      {
+        const std::uint64_t begin = nb.row_start[i], n = nb.row_start[i + 1] - begin;
+        const bool regular = nb.table_start[i] == 0 && n == nb.stencil_size;
+        if (regular && !table_checked.empty())
+          continue;
+        for (std::uint64_t k = 0; k < n; ++k)
+          {
+            const unsigned int q = box_index(i, begin + k);
+            if (q == centre || !uniform(sweep_half_of_box[q], nb.table_start[i] + k))
+              return;
+          }
+        if (regular)
+          table_checked.assign(1, true);
+      }
+
+    sweep_n_box   = n_box;
+    sweep_n_bytes = (sweep_n_box + 7) / 8;
+    // Padding: the neighbour streams read up to the largest offset plus one
+    // vector past the last box position.
+    sweep_n_alloc = 8 * sweep_n_bytes + sweep_offset.back() + 16;
+    sweep_position.resize(n_local);
+    sweep_node.assign(sweep_n_box, -1);
+    for (std::size_t i = 0; i < n_local; ++i)
+      {
+        std::int64_t L = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          L += std::int64_t(disc.lattice_index[i][d] - sweep_lower[d]) * sweep_stride[d];
+        AssertThrow(sweep_node[L] < 0, ExcInternalError("Two nodes share a lattice position."));
+        sweep_position[i] = L;
+        sweep_node[L]     = i;
+      }
+    sweep_p.assign(dim * sweep_n_alloc, 0.);
+    sweep_reaction.assign(dim * sweep_n_alloc, 0.);
+    sweep_bits_valid = false;
+    sweep_available  = true;
+#endif
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::build_sweep_bits()
+  {
+    const auto        &nb     = disc.neighborhood;
+    const unsigned int centre = centre_index();
+    sweep_live.assign(sweep_offset.size() * sweep_n_bytes, 0);
+    // The lower end of a bond (from which its offset is positive) and its
+    // offset; the bit is set by either owned copy and cleared if either
+    // copy is broken.
+    const auto bit = [&](const unsigned int i, const std::uint64_t b, std::size_t &byte) {
+      const unsigned int q = box_index(i, b);
+      const unsigned int h = sweep_half_of_box[q];
+      const std::uint32_t L = q > centre ? sweep_position[i] : sweep_position[nb.col[b]];
+      byte = h * sweep_n_bytes + L / 8;
+      return std::uint8_t(1u << (L % 8));
+    };
+    for (int pass = 0; pass < 2; ++pass)
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          if ((pass == 0) == (broken_flag[b] == 0))
+            {
+              std::size_t        byte;
+              const std::uint8_t m = bit(i, b, byte);
+              if (pass == 0)
+                sweep_live[byte] |= m;
+              else
+                sweep_live[byte] &= std::uint8_t(~m);
+            }
+    sweep_bits_valid = true;
+  }
+
+  template <int dim>
   void
   BondBasedOperator<dim>::initialize(VectorField &field) const
   {
@@ -309,6 +485,7 @@ namespace PeriDEAL
       std::int32_t                n_owned = 0;
       std::uint64_t               first_bond = 0; ///< CSR index of the row slice's bond 0
       std::vector<std::uint64_t> *newly_broken = nullptr;
+      bool                       *broke = nullptr; ///< set when a bond breaks (if not null)
     };
 
     /**
@@ -352,6 +529,8 @@ namespace PeriDEAL
           if (dl > s0 * r[b])
             {
               broken[b] = 1;
+              if (reaction.broke)
+                *reaction.broke = true;
               if (Scatter && col[b] < reaction.n_owned)
                 reaction.newly_broken->push_back(reaction.first_bond + b);
               continue;
@@ -478,6 +657,121 @@ namespace PeriDEAL
     }
 
     /**
+     * The PMB bond of eight lanes given l2 = |y|^2, the lengths rb and the
+     * stiffnesses kb: sets brk to the alive lanes with l - r > s0 r (2.34)
+     * and returns k (l - r) / l for the alive, unbroken lanes (0 for the
+     * others). 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton
+     * steps inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is
+     * the bottleneck of sqrt + div (doc/benchmarks.md); l - r by one
+     * explicit fused multiply-subtract. Every loop (full list, half list,
+     * ghost list, lattice sweep) calls this, so all of them see bitwise the
+     * same stretch of a bond and break it together.
+     */
+    inline __m512d
+    pmb_bond_scale(__m512d        l2,
+                   const __mmask8 alive,
+                   const __m512d  rb,
+                   const __m512d  kb,
+                   const __m512d  vs0,
+                   __mmask8      &brk)
+    {
+      // Masked-off and broken lanes get l2 = 1 to keep inv finite.
+      l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
+      const __m512d h = _mm512_mul_pd(_mm512_set1_pd(0.5), l2);
+      __m512d       inv = _mm512_rsqrt14_pd(l2);
+      for (unsigned int it = 0; it < 2; ++it)
+        inv = _mm512_mul_pd(inv,
+                            _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), _mm512_set1_pd(1.5)));
+      const __m512d dl = _mm512_fmsub_pd(l2, inv, rb);
+      brk = _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
+      return _mm512_maskz_mul_pd(alive & ~brk, _mm512_mul_pd(kb, dl), inv);
+    }
+
+    /**
+     * NO positive stencil offsets hs[0], ... of the lattice sweep over the
+     * box positions [c0, c0 + n) (n and c0 multiples of 8): bond
+     * (L, L + o_q) for every live bit (hs[q], L). p and reaction are
+     * dim arrays of stride N over the box positions; the force on L is
+     * accumulated in a (the chunk's buffer, dim arrays of stride C), the
+     * reaction of node L + o in reaction (F = a - reaction). The offsets
+     * share the loads of p_L and the update of a; they must lie more than
+     * 8 apart (else the reaction update of one partially overlaps the
+     * other's, and the store cannot be forwarded). Newly broken bonds clear
+     * their bit and are appended to @p broken as (h, L).
+     */
+    template <int dim, int NO>
+    inline void
+    sweep_offsets_avx512(const double       *p,
+                         double             *reaction,
+                         double             *a,
+                         std::uint8_t       *live,
+                         const std::size_t   n_bytes,
+                         const std::size_t   N,
+                         const unsigned int  C,
+                         const std::size_t   c0,
+                         const unsigned int  n,
+                         const std::int64_t *o,
+                         const unsigned int *hs,
+                         const double       *k,
+                         const double       *r,
+                         const double        s0,
+                         std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
+    {
+      std::uint8_t *bits[NO];
+      __m512d       vk[NO], vr[NO];
+      for (int q = 0; q < NO; ++q)
+        {
+          bits[q] = live + hs[q] * n_bytes + c0 / 8;
+          vk[q]   = _mm512_set1_pd(k[hs[q]]);
+          vr[q]   = _mm512_set1_pd(r[hs[q]]);
+        }
+      const __m512d vs0 = _mm512_set1_pd(s0);
+      for (unsigned int v = 0; v < n; v += 8)
+        {
+          __mmask8 alive[NO], any = 0;
+          for (int q = 0; q < NO; ++q)
+            any |= alive[q] = bits[q][v / 8];
+          if (any == 0)
+            continue;
+          const std::size_t L = c0 + v;
+          __m512d           pi[dim], acc[dim];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              pi[d]  = _mm512_loadu_pd(p + d * N + L);
+              acc[d] = _mm512_load_pd(a + d * C + v);
+            }
+          for (int q = 0; q < NO; ++q)
+            {
+              if (alive[q] == 0)
+                continue;
+              __m512d y[dim];
+              for (unsigned int d = 0; d < dim; ++d)
+                y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
+              __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+              for (unsigned int d = 1; d < dim; ++d)
+                l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+              __mmask8      brk;
+              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0, brk);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  double *rd = reaction + d * N + L + o[hs[q]];
+                  acc[d]     = _mm512_fmadd_pd(scale, y[d], acc[d]);
+                  _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
+                }
+              if (brk)
+                {
+                  bits[q][v / 8] = alive[q] & ~brk;
+                  for (unsigned int l = 0; l < 8; ++l)
+                    if ((brk >> l) & 1u)
+                      broken.emplace_back(hs[q], std::uint32_t(L + l));
+                }
+            }
+          for (unsigned int d = 0; d < dim; ++d)
+            _mm512_store_pd(a + d * C + v, acc[d]);
+        }
+    }
+
+    /**
      * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
      * one accumulator per component reduced once per row. Every bond goes
      * through the same instructions (1/l from vrsqrt14pd and Newton steps,
@@ -502,8 +796,7 @@ namespace PeriDEAL
       __m512d acc[dim];
       for (unsigned int d = 0; d < dim; ++d)
         acc[d] = _mm512_setzero_pd();
-      const __m512d vs0 = _mm512_set1_pd(s0), half = _mm512_set1_pd(0.5),
-                    three_halves = _mm512_set1_pd(1.5);
+      const __m512d vs0 = _mm512_set1_pd(s0);
       for (unsigned int b = 0; b < n; b += 8)
         {
           const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
@@ -516,22 +809,10 @@ namespace PeriDEAL
           __m512d l2 = _mm512_mul_pd(y[0], y[0]);
           for (unsigned int d = 1; d < dim; ++d)
             l2 = _mm512_fmadd_pd(y[d], y[d], l2);
-          // 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton steps
-          // inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is the
-          // bottleneck of sqrt + div (doc/benchmarks.md). Masked-off and
-          // broken lanes get l2 = 1 to keep inv finite.
-          l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-          const __m512d h = _mm512_mul_pd(half, l2);
-          __m512d       inv = _mm512_rsqrt14_pd(l2);
-          for (unsigned int it = 0; it < 2; ++it)
-            inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_halves));
-          const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
-          const __m512d dl = _mm512_fmsub_pd(l2, inv, rb);
-          const __mmask8 brk =
-            _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
-          const __mmask8 live = alive & ~brk;
-          const __m512d  scale =
-            _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), inv);
+          __mmask8      brk;
+          const __m512d scale =
+            pmb_bond_scale(l2, alive, _mm512_maskz_loadu_pd(alive, r + b),
+                           _mm512_maskz_loadu_pd(alive, k + b), vs0, brk);
           if constexpr (Scatter)
             {
               __m512d t[dim];
@@ -548,6 +829,8 @@ namespace PeriDEAL
           if (brk)
             {
               _mm_mask_storeu_epi8(broken + b, brk, _mm_set1_epi8(1));
+              if (reaction.broke)
+                *reaction.broke = true;
               if constexpr (Scatter)
                 for (unsigned int q = 0; q < 8; ++q)
                   if ((brk >> q) & 1u && col[b + q] < reaction.n_owned)
@@ -592,6 +875,9 @@ namespace PeriDEAL
     const auto    &nb = disc.neighborhood;
     const double  *p  = deformed.data();
     constexpr auto R  = node_stride<dim>;
+    bool           broke = false;
+    Reaction       reaction;
+    reaction.broke = &broke;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const std::uint64_t begin  = nb.row_start[i];
@@ -600,10 +886,13 @@ namespace PeriDEAL
                                      bond_coefficient.data() + nb.table_start[i],
                                      nb.bond_length.data() + nb.table_start[i],
                                      broken_flag.data() + begin, nb.row_start[i + 1] - begin, s0,
-                                     f, Reaction());
+                                     f, reaction);
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
       }
+    // The list loops change broken_flag without the sweep's bits.
+    if (broke)
+      sweep_bits_valid = false;
   }
 
   template <int dim>
@@ -623,6 +912,8 @@ namespace PeriDEAL
     reaction.force        = F;
     reaction.n_owned      = n_owned;
     reaction.newly_broken = &newly_broken;
+    bool broke            = false;
+    reaction.broke        = &broke;
     for (unsigned int i = 0; i < n_owned; ++i)
       {
         const std::uint64_t h = nb.row_start[i] + half_offset[i];
@@ -639,6 +930,8 @@ namespace PeriDEAL
     // Negative-offset bonds to ghosts, from the owned end only.
     for (std::size_t e = 0; e < ghost_bond.size(); ++e)
       ghost_broken[e] = broken_flag[ghost_bond[e]];
+    Reaction ghost_reaction;
+    ghost_reaction.broke = &broke;
     for (std::size_t g = 0; g < ghost_row.size(); ++g)
       {
         const unsigned int  i = ghost_row[g];
@@ -647,7 +940,7 @@ namespace PeriDEAL
         pmb_row_dispatch<dim, false>(p, p + std::size_t(R) * i, ghost_col.data() + e,
                                      ghost_stiffness.data() + e, ghost_length.data() + e,
                                      ghost_broken.data() + e, ghost_row_start[g + 1] - e, s0, f,
-                                     Reaction());
+                                     ghost_reaction);
         for (unsigned int d = 0; d < dim; ++d)
           F[R * i + d] += f[d];
       }
@@ -666,6 +959,93 @@ namespace PeriDEAL
         for (unsigned int i = 0; i < n_owned; ++i)
           fd[i] = F[R * i + d];
       }
+    if (broke)
+      sweep_bits_valid = false;
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::sweep_forces(const VectorField &u, VectorField &force)
+  {
+#ifdef PERIDEAL_PMB_AVX512
+    if (!sweep_bits_valid)
+      build_sweep_bits();
+    const std::vector<Point<dim>> &x       = disc.position;
+    const unsigned int             n_owned = disc.n_owned();
+    const std::size_t              N       = sweep_n_alloc;
+    // Deformed positions x - x_c + u as in the list loops (bitwise the same
+    // values), one array per component over the box.
+    std::array<int, dim> mid;
+    for (unsigned int d = 0; d < dim; ++d)
+      mid[d] = int(disc.lattice_size()[d] / 2);
+    const Point<dim> xc = disc.lattice_point(mid);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double       *pd = sweep_p.data() + d * N;
+        const double *ud = u[d].begin();
+        for (std::size_t i = 0; i < x.size(); ++i)
+          pd[sweep_position[i]] = (x[i][d] - xc[d]) + ud[i];
+      }
+    sweep_broken.clear();
+    // Chunks of C box positions, all offsets per chunk: the chunk's
+    // positions, forces and the reactions it reaches (up to the largest
+    // offset beyond it) stay in L2. A position's force is final once its
+    // chunk is done (reactions come from lower positions only).
+    constexpr unsigned int C = 512;
+    alignas(64) double     a[dim * C];
+    const std::int64_t     o_max  = sweep_offset.back();
+    const std::size_t      n_bits = 8 * sweep_n_bytes;
+    double                *R      = sweep_reaction.data();
+    std::size_t            zeroed = 0;
+    for (std::size_t c0 = 0; c0 < n_bits; c0 += C)
+      {
+        const unsigned int n    = std::min<std::size_t>(C, n_bits - c0);
+        const std::size_t  need = std::min<std::size_t>(N, c0 + n + o_max + 8);
+        for (unsigned int d = 0; d < dim; ++d)
+          std::fill(R + d * N + zeroed, R + d * N + need, 0.);
+        zeroed = std::max(zeroed, need);
+        std::fill(a, a + dim * C, 0.);
+        // Two offsets per pass (shared p_L loads and force updates): h and
+        // h + n_pairs, which lie in different lattice lines.
+        const unsigned int n_half = sweep_offset.size(), n_pairs = n_half / 2;
+        for (unsigned int h = 0; h < n_pairs; ++h)
+          {
+            const unsigned int hs[2] = {h, h + n_pairs};
+            sweep_offsets_avx512<dim, 2>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
+                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
+                                         sweep_r.data(), s0, sweep_broken);
+          }
+        if (n_half % 2)
+          {
+            const unsigned int hs[1] = {n_half - 1};
+            sweep_offsets_avx512<dim, 1>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
+                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
+                                         sweep_r.data(), s0, sweep_broken);
+          }
+        const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
+        for (std::size_t L = c0; L < c1; ++L)
+          {
+            const std::int32_t i = sweep_node[L];
+            if (i >= 0 && i < std::int32_t(n_owned))
+              for (unsigned int d = 0; d < dim; ++d)
+                force[d].local_element(i) = a[d * C + L - c0] - R[d * N + L];
+          }
+      }
+    // Flag the CSR copies of the newly broken bonds (rare).
+    const unsigned int centre = centre_index();
+    for (const auto &[h, L] : sweep_broken)
+      {
+        const std::int32_t lower = sweep_node[L], upper = sweep_node[L + sweep_offset[h]];
+        if (lower < std::int32_t(n_owned))
+          broken_flag[find_bond(lower, sweep_box_index[h])] = 1;
+        if (upper < std::int32_t(n_owned))
+          broken_flag[find_bond(upper, 2 * centre - sweep_box_index[h])] = 1;
+      }
+#else
+    (void)u;
+    (void)force;
+    Assert(false, ExcInternalError());
+#endif
   }
 
   template <int dim>
@@ -676,6 +1056,11 @@ namespace PeriDEAL
     const std::vector<Point<dim>> &x  = disc.position;
     const unsigned int             n_owned = disc.n_owned();
 
+    if (!linearized && uses_lattice_sweep())
+      {
+        sweep_forces(u, force);
+        return;
+      }
     if (!linearized)
       {
         // Deformed positions x - x_c + u of all local nodes, interleaved,
@@ -811,6 +1196,7 @@ namespace PeriDEAL
                       cuts(disc.position[j], disc.position[i]))
             broken_flag[b] = 1;
         }
+    sweep_bits_valid = false;
   }
 
   template <int dim>
@@ -903,7 +1289,8 @@ namespace PeriDEAL
   {
     AssertThrow(flags.size() == broken_flag.size(),
                 ExcMessage("One broken flag per bond of the owned rows is needed."));
-    broken_flag = flags;
+    broken_flag      = flags;
+    sweep_bits_valid = false;
   }
 
   template <int dim>

@@ -504,15 +504,42 @@ namespace
   // bound: the kernel forms y from deformed positions of size <= 1 (eps
   // |x| / |xi| ~ 2e-15 in the stretch) and 1/l by Newton steps (a few
   // ulp), so each term is off by ~1e-14 of its unit-stretch value.
+  // The nonlinear force loops of BondBasedOperator.
+  enum class Loop
+  {
+    full_list,
+    half_list,
+    lattice_sweep
+  };
+
+  // Select @p loop; the lattice sweep must be available where the library
+  // was compiled with AVX-512.
   template <int dim>
   void
-  force_kernel_dim(const bool half_list = false)
+  select_loop(BondBasedOperator<dim> &op, const Loop loop)
+  {
+    op.set_half_list(loop == Loop::half_list);
+    if (loop == Loop::lattice_sweep)
+      {
+        op.set_lattice_sweep(true);
+        if (BondBasedOperator<dim>::lattice_sweep_compiled())
+          check(op.uses_lattice_sweep(), std::to_string(dim) + "D: the lattice sweep is used");
+        else
+          std::cout << "  (no AVX-512 in the library: the sweep falls back to the full list)"
+                    << std::endl;
+      }
+  }
+
+  template <int dim>
+  void
+  force_kernel_dim(const Loop loop = Loop::full_list)
   {
     const auto               disc = make_box<dim>(MPI_COMM_WORLD, dim == 3 ? 1. : 2., 0.1, 0.3015);
     BondBasedModelParameters p;
     p.critical_stretch = 0.01;
     BondBasedOperator<dim> op(*disc, p);
-    op.set_half_list(half_list);
+    select_loop(op, loop);
+    const bool half_list = loop == Loop::half_list;
     typename BondBasedOperator<dim>::VectorField u, f;
     op.initialize(u);
     op.initialize(f);
@@ -567,7 +594,9 @@ namespace
     n_broken   = Utilities::MPI::sum(n_broken, MPI_COMM_WORLD);
     mismatched = Utilities::MPI::sum(mismatched, MPI_COMM_WORLD);
     asymmetric = Utilities::MPI::sum(asymmetric, MPI_COMM_WORLD);
-    const std::string tag = std::to_string(dim) + (half_list ? "D half list: " : "D: ");
+    const std::string tag = std::to_string(dim) + (half_list              ? "D half list: " :
+                                                   loop == Loop::lattice_sweep ? "D sweep: " :
+                                                                                 "D: ");
     check(n_broken > 0 && n_broken < nb.n_bonds() * Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD),
           tag + std::to_string(n_broken) + " bond copies broke");
     check(mismatched == 0, tag + std::to_string(mismatched) + " breaking decisions differ from s > s0");
@@ -594,14 +623,15 @@ namespace
   // force_kernel_dim().
   template <int dim>
   void
-  half_list_dim()
+  half_list_dim(const Loop loop = Loop::half_list)
   {
-    force_kernel_dim<dim>(true);
+    force_kernel_dim<dim>(loop);
     const auto               disc = make_box<dim>(MPI_COMM_WORLD, dim == 3 ? 1. : 2., 0.1, 0.3015);
     BondBasedModelParameters p;
     p.critical_stretch = 0.01;
     BondBasedOperator<dim> half(*disc, p), full(*disc, p);
-    half.set_half_list(true);
+    select_loop(half, loop);
+    select_loop(full, Loop::full_list);
     // Pre-crack-like random cuts: a symmetric predicate of the end points.
     const auto cuts = [](const Point<dim> &a, const Point<dim> &b) {
       double h = 0.;
@@ -680,6 +710,18 @@ namespace
     half_list_dim<2>();
     half_list_dim<3>();
   }
+
+  // The lattice sweep (one stencil offset at a time over the box of lattice
+  // positions, Newton's third law, broken flags as bits): the checks of
+  // half_list() (direct evaluation of (3.1); forces, broken flags of both
+  // copies and damage against the full list over two calls with pre-cut
+  // and newly breaking bonds; momentum), on 1 and 2 ranks.
+  void
+  lattice_sweep()
+  {
+    half_list_dim<2>(Loop::lattice_sweep);
+    half_list_dim<3>(Loop::lattice_sweep);
+  }
 } // namespace
 
 int
@@ -694,5 +736,6 @@ main(int argc, char **argv)
               {"fracture", fracture},
               {"rank_invariance", rank_invariance},
               {"force_kernel", force_kernel},
-              {"half_list", half_list}});
+              {"half_list", half_list},
+              {"lattice_sweep", lattice_sweep}});
 }

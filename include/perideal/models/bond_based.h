@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace PeriDEAL
@@ -190,6 +191,52 @@ namespace PeriDEAL
     set_half_list(const bool use_half_list)
     {
       half_list = use_half_list;
+      sweep     = false;
+    }
+
+    /**
+     * Select (true, the default) or deselect the lattice sweep of the
+     * nonlinear force: when every bond's stiffness and length depend only
+     * on its lattice offset (a uniform lattice, every node of volume
+     * dx^dim), the owned and ghost nodes are placed in a padded box in
+     * lattice order and the force loop runs over one positive stencil
+     * offset o at a time along contiguous runs of nodes: p_i and p_{i+o}
+     * are contiguous streams (no gathers, no row tails), the reaction goes
+     * to node i+o (Newton's third law), and the broken flags are one bit per
+     * (offset, box position). Forces equal those of the list loops up to
+     * round-off; the same bonds break (bitwise the same stretch
+     * arithmetic), and the CSR broken flags (broken(), damage()) are kept
+     * up to date. Where the sweep is not available (see
+     * lattice_sweep_available()) the list loop chosen by set_half_list() is
+     * used. set_half_list() deselects the sweep.
+     */
+    void
+    set_lattice_sweep(const bool use_sweep)
+    {
+      sweep = use_sweep;
+    }
+
+    /**
+     * True if compute_forces() can use the lattice sweep: nonlinear force,
+     * dim 2 or 3, compiled with AVX-512, lattice indices of all local
+     * nodes, per-offset uniform bond stiffness and length, and a box of
+     * lattice positions at most 8 times the local node count.
+     */
+    bool
+    lattice_sweep_available() const
+    {
+      return sweep_available;
+    }
+
+    /** True if the library was compiled with the AVX-512 sweep kernel. */
+    static bool
+    lattice_sweep_compiled();
+
+    /** True if compute_forces() currently runs the lattice sweep. */
+    bool
+    uses_lattice_sweep() const
+    {
+      return sweep && sweep_available;
     }
 
     /**
@@ -311,6 +358,42 @@ namespace PeriDEAL
     /** CSR index of the copy of bond @p b (row @p i, owned neighbour) in the neighbour's row. */
     std::uint64_t
     mirror_bond(const unsigned int i, const std::uint64_t b) const;
+    /** Lattice sweep selected (set_lattice_sweep()) and possible. */
+    bool sweep = true, sweep_available = false;
+    /** The sweep's live bits are in sync with broken_flag. */
+    bool sweep_bits_valid = false;
+    /** Box of local lattice positions: lower corner and strides (x fastest). */
+    std::array<int, dim>          sweep_lower;
+    std::array<std::int64_t, dim> sweep_stride;
+    /** Box positions and allocated length of the per-position arrays (padded). */
+    std::size_t sweep_n_box = 0, sweep_n_alloc = 0, sweep_n_bytes = 0;
+    /** Per positive stencil offset h: linear box offset, box index, stiffness, length. */
+    std::vector<std::int64_t> sweep_offset;
+    std::vector<unsigned int> sweep_box_index;
+    std::vector<double>       sweep_k, sweep_r;
+    /** Stencil-box index -> positive offset h (or of its negation), -1 for the centre. */
+    std::vector<int> sweep_half_of_box;
+    /** Box position of each local node, local node of each box position (-1: none). */
+    std::vector<std::uint32_t> sweep_position;
+    std::vector<std::int32_t>  sweep_node;
+    /** Bit (h, L): bond (L, L + offset h) exists in an owned row and is not broken. */
+    std::vector<std::uint8_t> sweep_live;
+    /** Deformed positions and reactions per box position, dim arrays of sweep_n_alloc. */
+    std::vector<double> sweep_p, sweep_reaction;
+    /** Scratch: (offset, box position) of the bonds broken in this call. */
+    std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
+    /** Set up the box, the offsets and sweep_available. */
+    void
+    setup_lattice_sweep();
+    /** Rebuild sweep_live from broken_flag. */
+    void
+    build_sweep_bits();
+    /** The nonlinear force by the lattice sweep. */
+    void
+    sweep_forces(const VectorField &u, VectorField &force);
+    /** CSR index of the bond of owned row @p i with stencil-box index @p target. */
+    std::uint64_t
+    find_bond(const unsigned int i, const unsigned int target) const;
     /** Build half_offset and the ghost list. */
     void
     setup_half_list();
