@@ -95,6 +95,11 @@ namespace PeriDEAL
 
       if (type != WaveBoundary::absorbing)
         return;
+      // Measured: with FE_Q(2) the EBF update has one-step spectral radius
+      // 1.008 (dt = 0.02, h = 0.5; 1.0002 even with a truncated
+      // pseudo-inverse), against 1.0025 for FE_Q(1) which truncation fixes.
+      check_parameter(prm.degree == 1, "FEM/Degree", prm.degree,
+                      "1 with the EBF absorbing boundary (FE_Q(2) + EBF is unstable: one-step spectral radius > 1)");
       // Absorbing nodes: the boundary DoFs; outward normal: the average of
       // the normals of their boundary faces (corners: the diagonal).
       const MappingQ1<dim>      mapping;
@@ -166,6 +171,19 @@ namespace PeriDEAL
           for (unsigned int c = 0; c < u_abc.size(); ++c)
             constant_defect[c] = 1. - u_abc[c];
         }
+      // Optional global stability guard (the cloud guards of Sect. 4.2.3 are
+      // not sufficient, see doc/design.md).
+      if (ap.spectral_check_size > 0 && 2 * (n + abc.cloud_points().size()) <= ap.spectral_check_size)
+        {
+          unsigned int n_up = 0;
+          spectral_radius   = one_step_spectral_radius(ap.spectral_check_size, &n_up);
+          if (spectral_radius > ap.max_spectral_radius)
+            throw ParameterError("Absorbing boundary/Pseudo-inverse tolerance",
+                                 std::to_string(ap.pseudo_inverse_tolerance),
+                                 "a value for which the one-step spectral radius (here " +
+                                   std::to_string(spectral_radius) + ", " + std::to_string(n_up) +
+                                   " eigenvalues > 1) is <= " + std::to_string(ap.max_spectral_radius));
+        }
     }
 
     template <int dim>
@@ -198,7 +216,9 @@ namespace PeriDEAL
 
     template <int dim>
     double
-    FemWave<dim>::one_step_spectral_radius(const unsigned int max_size, unsigned int *n_unstable)
+    FemWave<dim>::one_step_spectral_radius(const unsigned int    max_size,
+                                           unsigned int         *n_unstable,
+                                           std::complex<double> *dominant)
     {
       const unsigned int               n = u.size();
       const std::vector<unsigned int> &c = abc.cloud_points();
@@ -253,7 +273,9 @@ namespace PeriDEAL
       for (unsigned int i = 0; i < m; ++i)
         {
           const double mod = std::abs(map.eigenvalue(i));
-          rho              = std::max(rho, mod);
+          if (mod > rho && dominant)
+            *dominant = map.eigenvalue(i);
+          rho = std::max(rho, mod);
           n_up += mod > 1. + 1e-8 ? 1 : 0;
         }
       if (n_unstable)

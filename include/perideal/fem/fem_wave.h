@@ -15,6 +15,7 @@
 
 #include <perideal/abc/ebf_wave_abc.h>
 
+#include <complex>
 #include <functional>
 #include <string>
 #include <vector>
@@ -105,7 +106,9 @@ namespace PeriDEAL
        * of eigenvalues with modulus > 1 + 1e-8 goes to @p n_unstable.
        */
       double
-      one_step_spectral_radius(const unsigned int max_size = 4000, unsigned int *n_unstable = nullptr);
+      one_step_spectral_radius(const unsigned int    max_size   = 4000,
+                               unsigned int         *n_unstable = nullptr,
+                               std::complex<double> *dominant   = nullptr);
       /**
        * The dispersion relation the EBF ABC uses: "local" chi^2 |k|^2 (4.39),
        * or "discrete": the symbol of the lumped-mass Q1 scheme,
@@ -119,6 +122,11 @@ namespace PeriDEAL
       }
       /** Wall seconds in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
+      /**
+       * One-step spectral radius computed by the constructor when the state
+       * size is at most WaveAbcParameters::spectral_check_size (0 otherwise).
+       */
+      double spectral_radius = 0.;
 
       double
       time() const
