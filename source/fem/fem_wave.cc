@@ -294,13 +294,17 @@ namespace PeriDEAL
       if (type == WaveBoundary::absorbing)
         {
           const auto abc_start = clock::now();
-          abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
           // Only the cloud entries of the previous level are read.
-          for (const unsigned int q : abc.cloud_points())
+          if (extrapolate_velocity)
             {
-              u_old[q] = u[q];
-              v_old[q] = v[q];
+              abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
+              for (const unsigned int q : abc.cloud_points())
+                v_old[q] = v[q];
             }
+          else
+            abc.compute_values(u.begin(), u_old.data(), u_abc);
+          for (const unsigned int q : abc.cloud_points())
+            u_old[q] = u[q];
           abc_seconds += std::chrono::duration<double>(clock::now() - abc_start).count();
         }
       for (unsigned int i = 0; i < n; ++i)
