@@ -53,14 +53,15 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark kw_hybrid_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark kw_hybrid_benchmark fem_abc_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
 pmb_exe="$build/contrib/benchmarks/pmb_benchmark"
 abc_exe="$build/contrib/benchmarks/abc_benchmark"
 corrosion_exe="$build/contrib/benchmarks/corrosion_benchmark"
-for e in "$exe" "$pmb_exe" "$abc_exe" "$corrosion_exe"; do
+fem_abc_exe="$build/contrib/benchmarks/fem_abc_benchmark"
+for e in "$exe" "$pmb_exe" "$abc_exe" "$corrosion_exe" "$fem_abc_exe"; do
   [ -x "$e" ] || { echo "run-all: $e was not built" >&2; exit 1; }
 done
 
@@ -277,6 +278,7 @@ EOF_LMP
 fi
 # EBF absorbing boundaries: ABC work as a fraction of the step time (serial).
 "$abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
+"$fem_abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
 
 # 3D corrosion: hybrid vs standard, multi-grid / adaptive hybrid vs uniform
 # fine (serial; CORROSION_STEPS timed steps, default 10).

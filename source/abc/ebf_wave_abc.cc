@@ -568,6 +568,20 @@ namespace PeriDEAL
 
     template <int dim>
     void
+    EbfWaveAbc<dim>::compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const
+    {
+      u_new.resize(absorbing.size());
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        {
+          double su = 0.;
+          for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+            su += vg_now[c] * u[cloud_index[c]] + vg_old[c] * u_old[cloud_index[c]];
+          u_new[a] = su;
+        }
+    }
+
+    template <int dim>
+    void
     EbfWaveAbc<dim>::compute(const double        *u,
                              const double        *u_old,
                              const double        *v,

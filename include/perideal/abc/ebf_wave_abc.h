@@ -242,6 +242,10 @@ namespace PeriDEAL
               std::vector<double> &u_new,
               std::vector<double> &v_new) const;
 
+      /** Only u_new[a] = V_G . (u^n_j, u^{n-1}_j)_j (callers that derive v otherwise). */
+      void
+      compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const;
+
       const std::vector<unsigned int> &
       absorbing_points() const
       {

@@ -15,6 +15,7 @@
 
 #include <perideal/abc/ebf_wave_abc.h>
 
+#include <complex>
 #include <functional>
 #include <string>
 #include <vector>
@@ -34,6 +35,22 @@ namespace PeriDEAL
       double damping = 0.;
       /** Time step (> 0, below the lumped-mass CFL bound). */
       double time_step = 0.;
+      /**
+       * EBF ABC: extrapolate u - u_i^n instead of u at absorbing DoF i, i.e.
+       * add (1 - sum_j V_G,j) u_i^n, so that the static state u = const (an
+       * exact far-field solution) is kept exactly. The min-norm collocation
+       * (4.80) spreads a constant over damped modes and loses O(d dt) of it
+       * per step otherwise.
+       */
+      bool preserve_constants = true;
+      /**
+       * EBF ABC: v of the absorbing DoFs from V_H (4.82) as in the source
+       * (true), or the difference quotient (u^{n+1} - u^n) / dt (false). u
+       * does not depend on this choice (boundary velocities enter only V_H);
+       * with V_H the closed boundary-velocity recursion grows without bound
+       * in E13 (measured), which makes the energy (4.99) meaningless.
+       */
+      bool extrapolate_velocity = false;
     };
 
     /** Treatment of the truncation boundary of the FEM near field. */
@@ -79,6 +96,37 @@ namespace PeriDEAL
       /** Largest stable time step 2/sqrt(lambda_max) (Gershgorin bound of M^-1 K chi^2). */
       double
       critical_time_step() const;
+      /**
+       * Spectral radius of the linear one-step map of the truncated system
+       * (Verlet plus boundary treatment), the FEM counterpart of
+       * Abc::PdUnboundedWave::one_step_spectral_radius: state (u, v of all
+       * DoFs, u^{n-1}, v^{n-1} of the cloud points), mapped column by column
+       * through advance(), eigenvalues by LAPACK. At most @p max_size state
+       * entries (ParameterError otherwise); the state is restored. The number
+       * of eigenvalues with modulus > 1 + 1e-8 goes to @p n_unstable.
+       */
+      double
+      one_step_spectral_radius(const unsigned int    max_size   = 4000,
+                               unsigned int         *n_unstable = nullptr,
+                               std::complex<double> *dominant   = nullptr);
+      /**
+       * The dispersion relation the EBF ABC uses: "local" chi^2 |k|^2 (4.39),
+       * or "discrete": the symbol of the lumped-mass Q1 scheme,
+       * sum_j (-chi^2 K_ij / m_i) (1 - cos(k.(x_j - x_i))) from the stiffness
+       * row of the DoF nearest the mesh centre (a uniform Cartesian mesh).
+       */
+      const Abc::WaveDispersion<dim> &
+      dispersion() const
+      {
+        return relation;
+      }
+      /** Wall seconds in the ABC update and in the whole of advance(). */
+      double abc_seconds = 0., step_seconds = 0.;
+      /**
+       * One-step spectral radius computed by the constructor when the state
+       * size is at most WaveAbcParameters::spectral_check_size (0 otherwise).
+       */
+      double spectral_radius = 0.;
 
       double
       time() const
@@ -104,9 +152,17 @@ namespace PeriDEAL
       dealii::Vector<double>     mass, boundary_mass, u, v, a, Ku;
       std::vector<unsigned int>  boundary_dofs;
       Abc::EbfWaveAbc<dim>       abc;
+      Abc::WaveDispersion<dim>   relation;
       std::vector<double>        u_old, v_old, u_abc, v_abc;
+      /** 1 - V_G . 1 per absorbing DoF (0 without the constant correction). */
+      std::vector<double>        constant_defect;
       WaveBoundary               type;
+      bool                       extrapolate_velocity;
       double                     chi, d, dt, t = 0.;
+
+      /** a from the current u, v (what advance() leaves at every non-boundary DoF). */
+      void
+      set_acceleration();
     };
   } // namespace Fem
 } // namespace PeriDEAL

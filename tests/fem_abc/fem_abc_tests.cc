@@ -1,0 +1,303 @@
+// Tests of the deal.II FEM near fields with absorbing boundaries
+// (dissertation Sect. 4.2.2, 4.2.5 (E13) and Sect. 4.1): Fem::FemWave with
+// the EBF ABC vs the conventional first-order ABC (4.75) vs an extended
+// homogeneous-Dirichlet reference, the one-step spectral radius, and the
+// consistency of the absorbing update.
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/function_lib.h>
+
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/tria.h>
+
+#include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/base/exceptions.h>
+#include <perideal/fem/fem_wave.h>
+
+#include "../check.h"
+
+#include <cmath>
+#include <cstdlib>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  /** Environment override of a numeric test parameter (exploration only). */
+  double
+  env(const char *name, const double fallback)
+  {
+    return std::getenv(name) ? std::atof(std::getenv(name)) : fallback;
+  }
+
+  /** Reduced E13 set-up: near field (-L, L)^2, h = 0.5, chi = 1, d = 0.0125, Delta k = 1. */
+  struct E13
+  {
+    double                  L = 8., h = 0.5, dt = 0.02, t_end = 16.;
+    unsigned int            degree = 1;
+    Abc::WaveAbcParameters  abc;
+    Fem::FemWaveParameters  fem;
+    E13()
+    {
+      fem.damping          = 0.0125;
+      abc.wave_number_range = 1.;
+      abc.dispersion       = "local";
+      abc.cone_angle       = 0.5;
+    }
+    void
+    from_env()
+    {
+      L                     = env("FEM_L", L);
+      dt                    = env("FEM_DT", dt);
+      t_end                 = env("FEM_T", 2. * L);
+      degree                = static_cast<unsigned int>(env("FEM_DEG", degree));
+      abc.cone_angle        = env("FEM_CONE", abc.cone_angle);
+      abc.cloud_radius      = env("FEM_CR", abc.cloud_radius);
+      abc.n_wave_numbers    = static_cast<unsigned int>(env("FEM_NK", abc.n_wave_numbers));
+      abc.n_directions      = static_cast<unsigned int>(env("FEM_NPHI", abc.n_directions));
+      abc.direction_range   = env("FEM_DPHI", abc.direction_range);
+      abc.wave_number_range = env("FEM_DK", abc.wave_number_range);
+      abc.n_time_levels     = static_cast<unsigned int>(env("FEM_LEVELS", abc.n_time_levels));
+      fem.preserve_constants = env("FEM_PC", 1.) > 0.;
+      abc.pseudo_inverse_tolerance = env("FEM_TOL", abc.pseudo_inverse_tolerance);
+      fem.extrapolate_velocity = env("FEM_EV", 0.) > 0.;
+      if (std::getenv("FEM_DISP"))
+        abc.dispersion = std::getenv("FEM_DISP");
+    }
+  };
+
+  struct E13Result
+  {
+    double energy_ebf = 0., energy_first = 0., probe_ebf = 0., probe_first = 0.;
+    double final_ebf = 0., final_first = 0., abc_fraction = 0.;
+  };
+
+  double
+  pulse(const Point<2> &p)
+  {
+    return std::exp(-std::log(2.) * p.square() / 9.);
+  }
+
+  E13Result
+  run_e13(const E13 &c, const bool verbose)
+  {
+    Fem::FemWaveParameters fp = c.fem;
+    fp.degree                 = c.degree;
+    fp.time_step              = c.dt;
+    const ScalarFunctionFromFunctionObject<2> u0(pulse);
+    // The pulse has radius ~6; nothing reflected at L_ref is back in the
+    // compared square before t_end.
+    const double     L_ref = 0.5 * (c.t_end + c.L + 6.) + 3.;
+    Triangulation<2> near, far;
+    GridGenerator::subdivided_hyper_cube(near, static_cast<unsigned int>(std::round(2. * c.L / c.h)), -c.L, c.L);
+    GridGenerator::subdivided_hyper_cube(far, static_cast<unsigned int>(std::round(2. * L_ref / c.h)), -L_ref, L_ref);
+    Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, c.abc, u0);
+    Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, c.abc, u0);
+    Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, c.abc, u0);
+    const auto     &st = ebf.absorbing_boundary().statistics();
+    if (verbose && root())
+      std::cout << "    EBF (" << ebf.dispersion().name << "): " << st.n_absorbing << " absorbing DoFs, clouds "
+                << st.min_cloud_size << ".." << st.max_cloud_size << " stride " << st.max_stride << ", cond "
+                << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
+    const auto inside = [&](const Point<2> &p) { return std::max(std::abs(p[0]), std::abs(p[1])) < c.L - 1e-9; };
+    const double       e0      = ref.energy(inside);
+    const unsigned int n_steps = static_cast<unsigned int>(std::round(c.t_end / c.dt));
+    const unsigned int every   = std::max(1u, n_steps / 16);
+    const Point<2>     probe(0.625 * c.L, 0.3125 * c.L); // (20, 10) scaled from L = 26-32 to L
+    E13Result          r;
+    for (unsigned int s = 1; s <= n_steps; ++s)
+      {
+        ref.advance();
+        first.advance();
+        ebf.advance();
+        if (s % every == 0 || s == n_steps)
+          {
+            const double er = ref.energy(inside), ee = ebf.energy(inside), ef = first.energy(inside);
+            r.energy_ebf   = std::max(r.energy_ebf, std::abs(ee - er) / e0);
+            r.energy_first = std::max(r.energy_first, std::abs(ef - er) / e0);
+            const double ur = ref.value_at(probe);
+            r.probe_ebf     = std::max(r.probe_ebf, std::abs(ebf.value_at(probe) - ur));
+            r.probe_first   = std::max(r.probe_first, std::abs(first.value_at(probe) - ur));
+            if (verbose && root())
+              std::cout << "    t = " << ref.time() << ": |E-E_ref|/E0 EBF " << sci(std::abs(ee - er) / e0)
+                        << " first-order " << sci(std::abs(ef - er) / e0) << ", u(probe) - u_ref: EBF "
+                        << sci(ebf.value_at(probe) - ur) << " first-order " << sci(first.value_at(probe) - ur)
+                        << std::endl;
+          }
+      }
+    // Field error at the end: max over the near-field vertices.
+    Point<2> where;
+    const auto &dh = ebf.get_dof_handler();
+    for (const auto &cell : dh.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        {
+          const Point<2> p  = cell->vertex(v);
+          const double   ur = ref.value_at(p);
+          if (std::abs(ebf.value_at(p) - ur) > r.final_ebf)
+            where = p;
+          r.final_ebf       = std::max(r.final_ebf, std::abs(ebf.value_at(p) - ur));
+          r.final_first     = std::max(r.final_first, std::abs(first.value_at(p) - ur));
+        }
+    r.abc_fraction = ebf.abc_seconds / ebf.step_seconds;
+    if (verbose && root())
+      std::cout << "    summary: max |E-E_ref|/E0 EBF " << sci(r.energy_ebf) << " first " << sci(r.energy_first)
+                << "; max probe error EBF " << sci(r.probe_ebf) << " first " << sci(r.probe_first)
+                << "; field error at t_end EBF " << sci(r.final_ebf) << " first " << sci(r.final_first)
+                << " at (" << where << "); ABC time fraction " << sci(r.abc_fraction) << std::endl;
+    return r;
+  }
+
+  void
+  e13_explore()
+  {
+    E13 c;
+    c.from_env();
+    run_e13(c, true);
+  }
+
+  /** The E13 set-up of the tests: L = 16 (T = 32), Q1, discrete relation, Delta phi = pi/8. */
+  E13
+  e13_default()
+  {
+    E13 c;
+    c.L                   = 16.;
+    c.t_end               = 32.;
+    c.abc.dispersion      = "discrete";
+    c.abc.direction_range = M_PI / 8.; // [95]: Delta phi <= pi/8 (Sect. 4.3)
+    return c;
+  }
+
+  /**
+   * E13 reduced from (-26, 26)^2, t = 50, dt = 5e-4 to (-16, 16)^2, t = 32,
+   * dt = 0.02 (the results change by < 1 % for dt = 0.005). Proposed EBF vs
+   * first-order ABC (4.75) vs the extended Dirichlet reference.
+   */
+  void
+  e13()
+  {
+    const E13Result r = run_e13(e13_default(), true);
+    // Measured: energy 4.8e-4 vs 5.1e-3 (10.6x), probe 4.9e-4 vs 7.2e-3
+    // (14.8x), field at t_end 1.9e-3 vs 8.9e-3 (4.7x: the 10x at the
+    // end of the run is NOT reached; the largest EBF errors sit at the
+    // corners). Margins ~20 % below the measured ratios.
+    check(r.energy_ebf * 8. < r.energy_first,
+          "max |E - E_ref|/E0: EBF " + sci(r.energy_ebf) + " at least 8x below first-order " + sci(r.energy_first));
+    check(r.probe_ebf * 12. < r.probe_first,
+          "probe (10, 5): EBF " + sci(r.probe_ebf) + " at least 12x below first-order " + sci(r.probe_first));
+    check(r.final_ebf * 4. < r.final_first,
+          "field at t_end: EBF " + sci(r.final_ebf) + " at least 4x below first-order " + sci(r.final_first));
+  }
+
+  /**
+   * A constant state u = 1, v = 0 is an exact solution. The plain min-norm
+   * collocation loses it (measured max abs(u - 1) = 6.9e-3 after 800 steps; 0.59 with Delta phi = pi/4 and the local relation); the
+   * constant-preserving update keeps it to round-off.
+   */
+  void
+  constant_state()
+  {
+    for (const bool preserve : {true, false})
+      {
+        E13 c = e13_default();
+        c.fem.preserve_constants = preserve;
+        c.fem.time_step          = c.dt;
+        const Functions::ConstantFunction<2> one(1.);
+        Triangulation<2>                     tria;
+        GridGenerator::subdivided_hyper_cube(tria, 8, -2., 2.);
+        Fem::FemWave<2> ebf(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, one);
+        for (unsigned int s = 0; s < 800; ++s)
+          ebf.advance();
+        const double e = std::max(std::abs(ebf.value_at(Point<2>()) - 1.), std::abs(ebf.value_at(Point<2>(2., 2.)) - 1.));
+        if (preserve)
+          check(e < 1e-10, "constant kept by the corrected update: " + sci(e));
+        else
+          check(e > 1e-3, "plain min-norm update loses the constant (documents why the correction exists): " + sci(e));
+      }
+  }
+
+  double
+  radius(const Fem::WaveBoundary bc, const double tolerance, const unsigned int degree = 1)
+  {
+    E13 c                        = e13_default();
+    c.abc.pseudo_inverse_tolerance = tolerance;
+    c.fem.degree                 = degree;
+    c.fem.time_step              = c.dt;
+    const ScalarFunctionFromFunctionObject<2> u0(pulse);
+    Triangulation<2>                          tria;
+    GridGenerator::subdivided_hyper_cube(tria, 12, -3., 3.);
+    Fem::FemWave<2>      w(tria, c.fem, bc, c.abc, u0);
+    unsigned int         n_up = 0;
+    std::complex<double> dom;
+    const double         rho = w.one_step_spectral_radius(2000, &n_up, &dom);
+    if (root())
+      std::cout << "    spectral radius " << rho << " (" << n_up << " > 1, dominant " << dom << ")" << std::endl;
+    return rho;
+  }
+
+  /** One-step spectral radius of the FEM near field (h = 0.5, dt = 0.02, (-3, 3)^2). */
+  void
+  spectral_radius()
+  {
+    check(radius(Fem::WaveBoundary::dirichlet, 0.) <= 1., "Dirichlet: radius <= 1");
+    check(radius(Fem::WaveBoundary::first_order, 0.) <= 1., "first-order ABC: radius <= 1");
+    // Measured 1.0025 (growth 0.12 per unit time, frequency ~3.9 rad per unit
+    // time, a mesh-scale boundary mode); the cloud guards hold all the same.
+    const double rho = radius(Fem::WaveBoundary::absorbing, 0.);
+    check(rho > 1. + 1e-4, "EBF (full pseudo-inverse): weakly unstable, radius " + sci(rho - 1.) + " above 1 (known)");
+    // A truncated pseudo-inverse (relative cutoff 2e-3) is stable: the
+    // eigenvalue 1 is the preserved constant state; but it loses the
+    // accuracy (E13 field error 1.5e-2, worse than first order).
+    check(radius(Fem::WaveBoundary::absorbing, 2e-3) <= 1. + 1e-10, "EBF, cutoff 2e-3: radius <= 1");
+    // The guard rejects the unstable set-up with a ParameterError.
+    bool thrown = false;
+    try
+      {
+        E13 c                      = e13_default();
+        c.abc.spectral_check_size  = 2000;
+        c.fem.time_step            = c.dt;
+        const ScalarFunctionFromFunctionObject<2> u0(pulse);
+        Triangulation<2>                          tria;
+        GridGenerator::subdivided_hyper_cube(tria, 12, -3., 3.);
+        Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
+      }
+    catch (const ParameterError &e)
+      {
+        thrown = std::string(e.what()).find("Pseudo-inverse tolerance") != std::string::npos;
+      }
+    check(thrown, "spectral guard throws ParameterError naming the pseudo-inverse tolerance");
+  }
+
+  /** FE_Q(2) with the EBF ABC is rejected (radius 1.008 measured), FE_Q(3) always. */
+  void
+  bad_input()
+  {
+    const auto throws = [](const unsigned int degree, const Fem::WaveBoundary bc) {
+      E13 c           = e13_default();
+      c.fem.degree    = degree;
+      c.fem.time_step = 0.01;
+      const ScalarFunctionFromFunctionObject<2> u0(pulse);
+      Triangulation<2>                          tria;
+      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
+      try
+        {
+          Fem::FemWave<2> w(tria, c.fem, bc, c.abc, u0);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find("FEM/Degree") != std::string::npos;
+        }
+      return false;
+    };
+    check(throws(2, Fem::WaveBoundary::absorbing), "Q2 + EBF rejected naming FEM/Degree");
+    check(!throws(2, Fem::WaveBoundary::first_order), "Q2 + first-order ABC accepted");
+    check(throws(3, Fem::WaveBoundary::dirichlet), "Q3 rejected naming FEM/Degree");
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv, {{"e13_explore", e13_explore}, {"e13", e13}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}});
+}
