@@ -16,6 +16,8 @@ perideal_add_test(NAME abc.tutorial.step-5 COMMAND $<TARGET_FILE:step-5> ${CMAKE
 perideal_add_test(NAME abc.tutorial.step-5.full COMMAND $<TARGET_FILE:step-5> ${CMAKE_SOURCE_DIR}/tutorial/step-5/step-5.prm
   LABELS "tutorial;long" TIMEOUT 7200)
 perideal_add_test(NAME abc.pd_3d COMMAND $<TARGET_FILE:abc_tests> pd_3d LABELS convergence)
+# 3D lattice-sphere truncation: least-squares fit stopped by the guard, monotone fit stable.
+perideal_add_test(NAME abc.sphere_truncation COMMAND $<TARGET_FILE:abc_tests> sphere_truncation LABELS convergence)
 # 3D corrosion with the extended run on (-3, 3)^3 (227k nodes): too heavy for CI.
 perideal_add_test(NAME abc.corrosion_3d COMMAND $<TARGET_FILE:abc_tests> corrosion_3d
   LABELS "convergence;long" TIMEOUT 3000)
