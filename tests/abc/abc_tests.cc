@@ -414,7 +414,11 @@ namespace
   {
     std::vector<double> d;
     const History ref = pd_history<1>(10., 50., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::neumann, 0.);
-    for (const unsigned int layers : {1u, 2u, 3u, 4u})
+    // delta_L = dx diverges here (the source shows only reduced accuracy;
+    // see step-5/doc.md): the setup's stability check must stop it.
+    expect_error([&]() { pd_history<1>(10., 10., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::absorbing, 0.125); },
+                 "delta_L = dx: the stability check stops the diverging setup");
+    for (const unsigned int layers : {2u, 3u, 4u})
       {
         const auto c = compare(pd_history<1>(10., 10., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::absorbing,
                                              layers * 0.125), ref);
@@ -423,10 +427,7 @@ namespace
           std::cout << "  delta_L = " << layers << " dx: max Delta Pi/Pi0 " << c.max_difference
                     << ", final " << c.final_difference << std::endl;
       }
-    check(d[1] > d[2] && d[2] > d[3], "error decreases as delta_L grows from 2 dx to 4 dx (Fig. 4.11)");
-    // delta_L = dx diverges here (the source shows only reduced accuracy;
-    // see step-5/doc.md): asserted as "not better than 2 dx".
-    check(!(d[0] <= d[1]), "delta_L = dx not more accurate than 2 dx");
+    check(d[0] > d[1] && d[1] > d[2], "error decreases as delta_L grows from 2 dx to 4 dx (Fig. 4.11)");
   }
 
   // ------------------------------------------------------------------------
@@ -706,18 +707,21 @@ namespace
           "discrete PD = Fourier-integral PD solution to 1e-4 (m = 4 and 8)");
   }
 
-  // Long run: energy non-increasing over 1e6 steps (1D FEM and PD).
+  // Long run: energy non-increasing over @p n_steps steps (1D FEM, PD with
+  // the least-squares and the monotone fit).
   void
-  long_stability()
+  energy_stability(const unsigned int n_steps)
   {
-    for (const bool pd : {false, true})
+    for (const std::string method : {"FEM", "PD", "PD monotone"})
       {
+        const bool   pd = method != "FEM";
         const double L = 10., dx = 0.125, dt = 1e-3;
-        const unsigned int n_steps = 1000000;
         const auto   region        = cube<1>(L);
         HeatKernel<1>      c0;
         Abc::EbfParameters ap;
         ap.cloud_radius = 0.25 * (1. + 1e-9); // d_inf = delta / 2 = 2 dx
+        if (method == "PD monotone")
+          ap.fit = "monotone";
         bool   monotone = true;
         double e0 = 0., e = 0.;
         const auto march = [&](auto &run) {
@@ -752,9 +756,15 @@ namespace
             run.setup(Abc::TruncationBoundary::absorbing, ap, c0);
             march(run);
           }
+        const double t_end = n_steps * dt;
         if (root())
-          std::cout << "  " << (pd ? "PD" : "FEM") << ": Pi(t=1000)/Pi0 = " << e / e0 << std::endl;
-        check(monotone, std::string(pd ? "PD" : "FEM") + " 1D: energy non-increasing over 1e6 steps");
+          std::cout << "  " << method << ": Pi(t=" << t_end << ")/Pi0 = " << e / e0 << std::endl;
+        check(monotone && std::isfinite(e),
+              method + " 1D: energy non-increasing over " + std::to_string(n_steps) + " steps");
+        // The monotone fit: stability only (its accuracy is asserted in
+        // sphere_truncation).
+        if (n_steps < 1000000 || method == "PD monotone")
+          continue;
         // Heat kernel on (-L, L): Pi(t) = sqrt(pi/(8 s)) erf(L sqrt(8/s)), s = 1 + 16 t.
         const auto exact_pi = [L](const double t) {
           const double s = 1. + 16. * t;
@@ -1012,7 +1022,8 @@ main(int argc, char **argv)
               {"pd_fourier", pd_fourier},
               {"pd_layer_study", pd_layer_study},
               {"pd_rank_invariance", pd_rank_invariance},
-              {"long_stability", long_stability},
+              {"long_stability", []() { energy_stability(1000000); }},
+              {"stability", []() { energy_stability(100000); }},
               {"corrosion_2d", corrosion_2d},
               {"corrosion_3d", corrosion_3d},
               {"pd_3d", pd_3d},
