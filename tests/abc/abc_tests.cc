@@ -631,6 +631,21 @@ namespace
         check_close(all.energy[k], e1, 1e-12, "2D corrosion with ABC: Pi at record " + std::to_string(k) + ", ranks vs 1 rank");
         check_close(all.solid[k], s1, 1e-12, "2D corrosion with ABC: V_s at record " + std::to_string(k) + ", ranks vs 1 rank");
       }
+
+    // The monotone fit (NNLS per cloud) and the setup's stability check on
+    // all ranks vs 1.
+    auto ap_monotone = e10_abc(lp.delta);
+    ap_monotone.fit  = "monotone";
+    const auto run_monotone = [&](const MPI_Comm comm) {
+      return corrosion_record<2>(0.6, 0.56, lp, e10_model(), ap_monotone, c0, 5e-6, 200, 100,
+                                 Abc::TruncationBoundary::absorbing, comm);
+    };
+    const CorrosionRecord all_m = run_monotone(MPI_COMM_WORLD);
+    CorrosionRecord       one_m = all_m;
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      one_m = run_monotone(MPI_COMM_SELF);
+    check_close(all_m.energy.back(), Utilities::MPI::broadcast(MPI_COMM_WORLD, one_m.energy.back(), 0), 1e-12,
+                "2D corrosion, monotone fit: Pi at t = 0.001, ranks vs 1 rank");
   }
 
   // 1D PD diffusion of C0 = exp(-4x^2) on the real line has the
