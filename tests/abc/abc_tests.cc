@@ -414,7 +414,11 @@ namespace
   {
     std::vector<double> d;
     const History ref = pd_history<1>(10., 50., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::neumann, 0.);
-    for (const unsigned int layers : {1u, 2u, 3u, 4u})
+    // delta_L = dx diverges here (the source shows only reduced accuracy;
+    // see step-5/doc.md): the setup's stability check must stop it.
+    expect_error([&]() { pd_history<1>(10., 10., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::absorbing, 0.125); },
+                 "delta_L = dx: the stability check stops the diverging setup");
+    for (const unsigned int layers : {2u, 3u, 4u})
       {
         const auto c = compare(pd_history<1>(10., 10., 0.125, 4., 1e-3, 40., Abc::TruncationBoundary::absorbing,
                                              layers * 0.125), ref);
@@ -423,10 +427,7 @@ namespace
           std::cout << "  delta_L = " << layers << " dx: max Delta Pi/Pi0 " << c.max_difference
                     << ", final " << c.final_difference << std::endl;
       }
-    check(d[1] > d[2] && d[2] > d[3], "error decreases as delta_L grows from 2 dx to 4 dx (Fig. 4.11)");
-    // delta_L = dx diverges here (the source shows only reduced accuracy;
-    // see step-5/doc.md): asserted as "not better than 2 dx".
-    check(!(d[0] <= d[1]), "delta_L = dx not more accurate than 2 dx");
+    check(d[0] > d[1] && d[1] > d[2], "error decreases as delta_L grows from 2 dx to 4 dx (Fig. 4.11)");
   }
 
   // ------------------------------------------------------------------------
@@ -630,6 +631,21 @@ namespace
         check_close(all.energy[k], e1, 1e-12, "2D corrosion with ABC: Pi at record " + std::to_string(k) + ", ranks vs 1 rank");
         check_close(all.solid[k], s1, 1e-12, "2D corrosion with ABC: V_s at record " + std::to_string(k) + ", ranks vs 1 rank");
       }
+
+    // The monotone fit (NNLS per cloud) and the setup's stability check on
+    // all ranks vs 1.
+    auto ap_monotone = e10_abc(lp.delta);
+    ap_monotone.fit  = "monotone";
+    const auto run_monotone = [&](const MPI_Comm comm) {
+      return corrosion_record<2>(0.6, 0.56, lp, e10_model(), ap_monotone, c0, 5e-6, 200, 100,
+                                 Abc::TruncationBoundary::absorbing, comm);
+    };
+    const CorrosionRecord all_m = run_monotone(MPI_COMM_WORLD);
+    CorrosionRecord       one_m = all_m;
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      one_m = run_monotone(MPI_COMM_SELF);
+    check_close(all_m.energy.back(), Utilities::MPI::broadcast(MPI_COMM_WORLD, one_m.energy.back(), 0), 1e-12,
+                "2D corrosion, monotone fit: Pi at t = 0.001, ranks vs 1 rank");
   }
 
   // 1D PD diffusion of C0 = exp(-4x^2) on the real line has the
@@ -706,18 +722,21 @@ namespace
           "discrete PD = Fourier-integral PD solution to 1e-4 (m = 4 and 8)");
   }
 
-  // Long run: energy non-increasing over 1e6 steps (1D FEM and PD).
+  // Long run: energy non-increasing over @p n_steps steps (1D FEM, PD with
+  // the least-squares and the monotone fit).
   void
-  long_stability()
+  energy_stability(const unsigned int n_steps)
   {
-    for (const bool pd : {false, true})
+    for (const std::string method : {"FEM", "PD", "PD monotone"})
       {
+        const bool   pd = method != "FEM";
         const double L = 10., dx = 0.125, dt = 1e-3;
-        const unsigned int n_steps = 1000000;
         const auto   region        = cube<1>(L);
         HeatKernel<1>      c0;
         Abc::EbfParameters ap;
         ap.cloud_radius = 0.25 * (1. + 1e-9); // d_inf = delta / 2 = 2 dx
+        if (method == "PD monotone")
+          ap.fit = "monotone";
         bool   monotone = true;
         double e0 = 0., e = 0.;
         const auto march = [&](auto &run) {
@@ -752,9 +771,15 @@ namespace
             run.setup(Abc::TruncationBoundary::absorbing, ap, c0);
             march(run);
           }
+        const double t_end = n_steps * dt;
         if (root())
-          std::cout << "  " << (pd ? "PD" : "FEM") << ": Pi(t=1000)/Pi0 = " << e / e0 << std::endl;
-        check(monotone, std::string(pd ? "PD" : "FEM") + " 1D: energy non-increasing over 1e6 steps");
+          std::cout << "  " << method << ": Pi(t=" << t_end << ")/Pi0 = " << e / e0 << std::endl;
+        check(monotone && std::isfinite(e),
+              method + " 1D: energy non-increasing over " + std::to_string(n_steps) + " steps");
+        // The monotone fit: stability only (its accuracy is asserted in
+        // sphere_truncation).
+        if (n_steps < 1000000 || method == "PD monotone")
+          continue;
         // Heat kernel on (-L, L): Pi(t) = sqrt(pi/(8 s)) erf(L sqrt(8/s)), s = 1 + 16 t.
         const auto exact_pi = [L](const double t) {
           const double s = 1. + 16. * t;
@@ -782,6 +807,8 @@ namespace
     double energy_tolerance, solid_tolerance;
     /** Truncate by the cube (-R, R)^dim instead of the ball. */
     bool cube = false;
+    /** Required ratio of the Neumann to the ABC difference at t_end. */
+    double required_gain = 10.;
   };
 
   /**
@@ -824,8 +851,9 @@ namespace
                                            " V_s(0) of the extended domain");
     check(da.first < c.energy_tolerance, name + "Delta Pi/Pi0 (4.35) within " + sci(c.energy_tolerance) +
                                            " of the extended domain over the run");
-    check(dn.first > 10. * da_final.first,
-          name + "ABC at least 10x closer to the reference than Neumann at t_end (ratio " +
+    check(dn.first > c.required_gain * da_final.first,
+          name + "ABC at least " + sci(c.required_gain) +
+            "x closer to the reference than Neumann at t_end (ratio " +
             sci(dn.first / da_final.first) + ")");
     check(abc.monotone, name + "near-field energy non-increasing every step (Fig. 4.16)");
   }
@@ -875,6 +903,84 @@ namespace
     ap.wave_number_range = 0.;
     CorrosionCase c{1., 3., 1e-5, 0.01, 100, 2e-3, 1e-3};
     c.cube = true;
+    corrosion_case<3>(c, lp, e10_model(), ap, c0);
+  }
+
+  /**
+   * Truncation by a lattice sphere (radius 10 dx) in 3D, E11 material as in
+   * corrosion_3d. The least-squares fit (4.31) gives clouds with sum_j |V_j|
+   * up to 2.4 on the staircase of the lattice sphere; unchecked, that run
+   * reaches Pi/Pi0 = 7e80 by t = 0.005. The setup's stability check must
+   * stop it naming the cloud. The monotone fit (V_j >= 0, sum V_j = 1) makes every row of the
+   * one-step map a convex combination: stable by construction; asserted
+   * against the extended reference (ball of radius 2, 33,401 nodes).
+   */
+  void
+  sphere_truncation()
+  {
+    LatticeParameters lp;
+    lp.dx    = 0.1;
+    lp.delta = 0.2;
+    ShapeIndicator<3> c0([](const Point<3> &x) { return x.norm() <= 0.5; }, 1.);
+    // d_inf = delta: with 1.44 dx (the cube's choice) the pole nodes of the
+    // lattice sphere have 6 points (< 7, the guard). Delta k = 2/d_inf = 10:
+    // scan of the monotone fit (max Delta Pi/Pi0): 3: 9.4e-3, 5: 1.2e-2, 10:
+    // 7.5e-3, 20: 2.8e-2.
+    auto ap              = e10_abc(lp.delta);
+    ap.wave_number_range = 0.;
+    const double dt      = 1e-5;
+    // Least-squares fit: the setup's power iteration finds the growth and
+    // names the cloud.
+    try
+      {
+        BallDomain<3>                ball(Point<3>(), 1.);
+        Abc::PdUnboundedDiffusion<3> run(MPI_COMM_WORLD);
+        run.setup(ball, lp, e10_model(), dt, Abc::TruncationBoundary::absorbing, ap, c0);
+        check(false, "lattice sphere, least-squares fit: no ParameterError");
+      }
+    catch (const ParameterError &e)
+      {
+        const std::string what = e.what();
+        if (root())
+          std::cout << "  " << what << std::endl;
+        check(what.find("one-step growth") != std::string::npos &&
+                what.find("cloud of absorbing node") != std::string::npos,
+              "lattice sphere, least-squares fit: setup stops naming the growth and the cloud");
+      }
+    ap.fit = "monotone";
+    {
+      BallDomain<3>                ball(Point<3>(), 1.);
+      Abc::PdUnboundedDiffusion<3> run(MPI_COMM_WORLD);
+      run.setup(ball, lp, e10_model(), dt, Abc::TruncationBoundary::absorbing, ap, c0);
+      const auto &abc = run.absorbing_boundary();
+      double      min_v = 0., max_sum_error = 0.;
+      for (unsigned int a = 0; a < abc.absorbing_points().size(); ++a)
+        {
+          double sum = 0.;
+          for (const auto &[j, v] : abc.cloud(a))
+            {
+              min_v = std::min(min_v, v);
+              sum += v;
+            }
+          max_sum_error = std::max(max_sum_error, std::abs(sum - 1.));
+        }
+      max_sum_error = Utilities::MPI::max(max_sum_error, MPI_COMM_WORLD);
+      min_v         = Utilities::MPI::min(min_v, MPI_COMM_WORLD);
+      if (root())
+        std::cout << "  monotone fit: min V_j " << min_v << ", max |sum V_j - 1| " << max_sum_error
+                  << ", max fit residual " << abc.statistics().max_fit_residual << ", one-step growth "
+                  << run.stability_growth << std::endl;
+      check(min_v >= 0. && max_sum_error < 1e-12, "monotone fit: V_j >= 0 and sum_j V_j = 1 in every cloud");
+    }
+    // R_ref = 2: the run ends before the solid's concentration (gone at t =
+    // 0.00275) reaches it, exp(-1.5^2 / (4 D_liq t_end)) = 0.08 of the
+    // front; it is the reference for Omega_N = |x| <= 0.8 only. Measured
+    // with the monotone fit: max Delta Pi/Pi0 7.5e-3 (the ABC under-absorbs
+    // late: Pi/Pi0 0.028 vs 0.020 at t_end), Neumann 4.6e-2 at t_end, gain
+    // 6.1. Asserted: 1e-2 over the run, gain >= 5; the radius-10 dx sphere
+    // is half absorbing layer (2,060 of 4,169 nodes).
+    CorrosionCase c{1., 2., dt, 0.005, 25, 1e-2, 1e-3};
+    c.required_gain = 5.;
     corrosion_case<3>(c, lp, e10_model(), ap, c0);
   }
 
@@ -931,8 +1037,10 @@ main(int argc, char **argv)
               {"pd_fourier", pd_fourier},
               {"pd_layer_study", pd_layer_study},
               {"pd_rank_invariance", pd_rank_invariance},
-              {"long_stability", long_stability},
+              {"long_stability", []() { energy_stability(1000000); }},
+              {"stability", []() { energy_stability(100000); }},
               {"corrosion_2d", corrosion_2d},
               {"corrosion_3d", corrosion_3d},
-              {"pd_3d", pd_3d}});
+              {"pd_3d", pd_3d},
+              {"sphere_truncation", sphere_truncation}});
 }

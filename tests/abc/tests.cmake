@@ -8,6 +8,8 @@ foreach(_t fem_1d fem_2d pd_1d pd_2d pd_fourier pd_layer_study corrosion_2d)
 endforeach()
 perideal_add_test(NAME abc.pd_rank_invariance.np2 NPROCS 2
   COMMAND $<TARGET_FILE:abc_tests> pd_rank_invariance LABELS mpi)
+# 1e5 steps (t = 100) of the 1D runs of long_stability: energy non-increasing.
+perideal_add_test(NAME abc.stability COMMAND $<TARGET_FILE:abc_tests> stability LABELS convergence)
 perideal_add_test(NAME abc.long_stability COMMAND $<TARGET_FILE:abc_tests> long_stability
   LABELS long TIMEOUT 3000)
 # step-5 with a reduced near field (-10, 10), reference (-50, 50), t_f = 40.
@@ -16,6 +18,8 @@ perideal_add_test(NAME abc.tutorial.step-5 COMMAND $<TARGET_FILE:step-5> ${CMAKE
 perideal_add_test(NAME abc.tutorial.step-5.full COMMAND $<TARGET_FILE:step-5> ${CMAKE_SOURCE_DIR}/tutorial/step-5/step-5.prm
   LABELS "tutorial;long" TIMEOUT 7200)
 perideal_add_test(NAME abc.pd_3d COMMAND $<TARGET_FILE:abc_tests> pd_3d LABELS convergence)
+# 3D lattice-sphere truncation: least-squares fit stopped by the guard, monotone fit stable.
+perideal_add_test(NAME abc.sphere_truncation COMMAND $<TARGET_FILE:abc_tests> sphere_truncation LABELS convergence)
 # 3D corrosion with the extended run on (-3, 3)^3 (227k nodes): too heavy for CI.
 perideal_add_test(NAME abc.corrosion_3d COMMAND $<TARGET_FILE:abc_tests> corrosion_3d
   LABELS "convergence;long" TIMEOUT 3000)

@@ -197,6 +197,9 @@ namespace Step5
         Abc::PdUnboundedDiffusion<1> solver(MPI_COMM_WORLD);
         Abc::EbfParameters           ap = p.abc;
         ap.layer_thickness              = layer;
+        // The study reports the diverging delta_L = dx run; the setup's
+        // stability check would stop it (one-step growth 1.048).
+        ap.stability_check_steps = 0;
         solver.setup(box, lp, model, p.dt, boundary, ap, c0);
         Timer  timer;
         Series s{"PD " + name, {}, true, 0., 0.};

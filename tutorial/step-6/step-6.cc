@@ -236,7 +236,8 @@ namespace Step6
                   << st.min_cloud_size << ".." << st.max_cloud_size << " points, Delta k "
                   << st.wave_number_range << " (bound (4.33) " << st.wave_number_bound << "), condition "
                   << st.max_condition_number << ", max |V| " << st.max_update_norm << ", max sum |V| "
-                  << st.max_update_l1 << ", setup " << timer.wall_time() << " s" << std::endl;
+                  << st.max_update_l1 << ", one-step growth " << run.stability_growth << ", setup "
+                  << timer.wall_time() << " s" << std::endl;
       }
     // Pi and the mass on Omega_N of the truncated run (radius R - delta_L).
     const double layer = p.abc.layer_thickness > 0 ? p.abc.layer_thickness : p.delta;

@@ -47,6 +47,28 @@ namespace PeriDEAL
       double max_condition_number = 1e12;
       /** Stability guard: largest admissible max-norm of an updating vector. */
       double max_update_norm = 2.;
+      /**
+       * How V is fitted to the modes. "least squares": V = Psi(dt) M_G^+
+       * (4.31). "monotone": the same least-squares fit restricted to V_j >= 0,
+       * sum_j V_j = 1 (the constant far field is kept exactly). With a
+       * monotone near field (forward Euler at dt <= 1 / max row sum) every
+       * row of the one-step map is then a convex combination, so
+       * max_i |C_i| cannot grow: stable for every cloud shape.
+       */
+      std::string fit = "least squares";
+      /**
+       * Optional guard for the least-squares fit: largest admissible
+       * sum_j |V_j| (the infinity norm of an absorbing row of the one-step
+       * map; <= 1 is sufficient for stability, not necessary: off by
+       * default).
+       */
+      double max_update_l1 = 1e10;
+      /**
+       * PD near field: steps of the power iteration of the one-step map
+       * run at setup (0: none). Growth stops the setup with a
+       * ParameterError naming the cloud where the growing mode lives.
+       */
+      unsigned int stability_check_steps = 200;
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -105,6 +127,8 @@ namespace PeriDEAL
       double max_update_norm = 0.;
       /** Largest sum_j |V_j| (the amplification bound of one update). */
       double max_update_l1 = 0.;
+      /** Largest relative residual |V M_G - Psi(dt)| / |Psi(dt)| of the fit. */
+      double max_fit_residual = 0.;
       /** Delta k used and the bound (4.33) 1/sqrt(D dt). */
       double wave_number_range = 0., wave_number_bound = 0.;
     };

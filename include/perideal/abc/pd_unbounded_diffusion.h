@@ -124,8 +124,24 @@ namespace PeriDEAL
       }
       /** Wall seconds spent in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
+      /**
+       * Growth per step of the one-step map (phases frozen) measured by the
+       * setup's power iteration over the last quarter of its steps (0 if
+       * not run). > 1 means an unstable mode; setup throws then.
+       */
+      double stability_growth = 0.;
 
     private:
+      /**
+       * Power iteration of the linear one-step map (forward Euler with the
+       * current phases, then the absorbing update) from a pseudo-random
+       * vector keyed by node id (rank independent). Sets stability_growth
+       * and throws a ParameterError naming the cloud of the absorbing node
+       * where the growing vector peaks if the growth exceeds 1.
+       */
+      void
+      check_stability(const unsigned int n_steps);
+
       Discretization<dim>                   disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       EbfDiffusionAbc<dim>                  abc;
