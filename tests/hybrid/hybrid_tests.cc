@@ -304,8 +304,9 @@ namespace
   // out here with the full operator (every row, also the volume-constraint
   // layer), on the hybrid corrosion case of (4) with a non-zero Dirichlet
   // value (so the layer rows of L C are non-zero and would spoil C if they
-  // were read). The solution and the phase must agree bitwise at every step:
-  // each interior row is the same sum in the same order.
+  // were read). The solution and the phase must agree at every step:
+  // each interior row is the same sum in the same order; the
+  // hand-written update below may round differently (FMA), see there.
   void
   layer_rows_skipped()
   {
@@ -332,7 +333,7 @@ namespace
     const unsigned int n    = disc.n_owned();
     PeriDEAL::Vector   C = solver.solution(), phase = solver.phase_field(), rate = C;
     unsigned int       n_layer = 0, n_mismatch = 0, n_phase_changes = 0;
-    double             max_layer_rate = 0.;
+    double             max_layer_rate = 0., max_diff = 0.;
     for (unsigned int i = 0; i < n; ++i)
       n_layer += disc.region[i] == Discretization<2>::constrained;
     while (solver.step() < solver.n_steps())
@@ -348,9 +349,17 @@ namespace
         C.update_ghost_values();
         n_phase_changes += update_corrosion_phase(prm.model, C, phase, n);
         phase.update_ghost_values();
+        // The hand-written update may contract to FMA differently from the
+        // library's, so C agrees to round-off (not bitwise); restart every
+        // step from the solver's state so that differences cannot grow.
         for (unsigned int i = 0; i < n; ++i)
-          n_mismatch += C.local_element(i) != solver.solution().local_element(i) ||
-                        phase.local_element(i) != solver.phase_field().local_element(i);
+          {
+            max_diff = std::max(max_diff, std::abs(C.local_element(i) -
+                                                   solver.solution().local_element(i)));
+            n_mismatch += phase.local_element(i) != solver.phase_field().local_element(i);
+          }
+        C     = solver.solution();
+        phase = solver.phase_field();
       }
     // The restricted apply() leaves the layer entries untouched.
     PeriDEAL::Vector part = rate;
@@ -372,8 +381,10 @@ namespace
     check(n_layer > 0 && solver.n_wls_rows() > 0 && n_phase_changes > 0,
           "the case has a layer, WLS rows and phase changes");
     check(max_layer_rate > 1e-3, "the skipped layer rows are non-zero");
-    check(n_mismatch == 0, "C and phase bitwise equal to the full-row run at every step (" +
-                             std::to_string(n_mismatch) + " differences)");
+    // C is O(1): 1e-14 is a few ulps of one update C + dt L C.
+    check(max_diff <= 1e-14 && n_mismatch == 0,
+          "every step: C equal to the full-row update to round-off (max diff " + sci(max_diff) +
+            "), phase equal (" + std::to_string(n_mismatch) + " differences)");
     check(n_wrong == 0, "Rows::interior: interior rows bitwise equal, layer untouched");
   }
 
