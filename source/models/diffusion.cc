@@ -3,6 +3,7 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/diffusion.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace PeriDEAL
@@ -189,11 +190,24 @@ namespace PeriDEAL
           s += w[k];
         row_sum[i] = s;
       }
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (disc.region[i] == Discretization<dim>::interior)
+        interior_standard_rows.push_back(i);
   }
 
   template <int dim>
   void
   DiffusionOperator<dim>::apply(const Vector &C, Vector &rate, const Vector *phase) const
+  {
+    apply(C, rate, phase, Rows::all);
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::apply(const Vector &C,
+                                Vector       &rate,
+                                const Vector *phase,
+                                const Rows    rows) const
   {
     const auto          &nb        = disc.neighborhood;
     const double *const  c         = C.begin();
@@ -203,22 +217,30 @@ namespace PeriDEAL
     const std::uint64_t *table     = nb.table_start.data();
     const double        *gw        = geometric_weight.data();
     const unsigned int   n         = disc.n_owned();
+    // The standard-scheme rows: all owned rows except Omega_w (written by
+    // the WLS rows below), or the list of interior ones built at setup.
+    const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
+    auto for_standard_rows    = [&](auto &&row) {
+      if (rows == Rows::interior)
+        for (const unsigned int i : interior_standard_rows)
+          row(i);
+      else
+        for (unsigned int i = 0; i < n; ++i)
+          if (skip == nullptr || !skip[i])
+            row(i);
+    };
 
     if (!corrosion)
       {
         const double kappa = kappa_table[0];
-        const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
-        for (unsigned int i = 0; i < n; ++i)
-          {
-            if (skip != nullptr && skip[i]) // Omega_w: written by the WLS rows below
-              continue;
+        for_standard_rows([&](const unsigned int i) {
             const std::int32_t *ci = col + row_start[i];
             const double       *wi = gw + table[i];
             const unsigned int  m  = row_start[i + 1] - row_start[i];
             const double        s  = m < 1024 ? weighted_row_sum_short(ci, wi, m, c) :
                                                 weighted_row_sum_long(ci, wi, m, c);
             r[i] = kappa * (s - row_sum[i] * c[i]);
-          }
+          });
         if (wls) // Omega_w: the WLS rows (weights carry kappa), same short-row kernel
           for (unsigned int k = 0; k < wls->node.size(); ++k)
             {
@@ -245,10 +267,7 @@ namespace PeriDEAL
         }
       return s;
     };
-    const unsigned char *skip = is_wls.empty() ? nullptr : is_wls.data();
-    for (unsigned int i = 0; i < n; ++i)
-      if (skip == nullptr || !skip[i])
-        r[i] = standard_row(i);
+    for_standard_rows([&](const unsigned int i) { r[i] = standard_row(i); });
     if (wls)
       // Omega_w: a WLS row is one phase's operator, valid while all its
       // collocation nodes share the phase of x_i (kappa of that phase's
@@ -315,6 +334,10 @@ namespace PeriDEAL
                     ExcMessage("WLS rows must be owned interior nodes."));
         is_wls[i] = 1;
       }
+    interior_standard_rows.erase(std::remove_if(interior_standard_rows.begin(),
+                                                interior_standard_rows.end(),
+                                                [&](const unsigned int i) { return is_wls[i]; }),
+                                 interior_standard_rows.end());
     // Diffusion: the kernel carries kappa; corrosion: constant 1, kappa per row.
     wls = std::make_unique<WlsQuadrature<dim>>(parameters, scalar_kernel);
     // Not build(disc, rows): an empty list would mean "all interior nodes".

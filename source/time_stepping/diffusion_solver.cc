@@ -362,7 +362,9 @@ namespace PeriDEAL
   {
     {
       TimerOutput::Scope scope(computing_timer, "operator");
-      op->apply(C, rate, &phase);
+      // Only the interior rows: the layer is overwritten by apply_dirichlet()
+      // and rate is read nowhere else.
+      op->apply(C, rate, &phase, DiffusionOperator<dim>::Rows::interior);
     }
     const double t_new = current_time + dt;
     source_function.set_time(current_time);

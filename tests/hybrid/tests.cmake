@@ -1,7 +1,7 @@
 # Hybrid fixed configuration (dissertation Sect. 3.3) for PD diffusion:
 # standard scheme near the boundary, WLS-2 elsewhere (one executable).
 perideal_add_test_program(hybrid_tests ${CMAKE_CURRENT_LIST_DIR}/hybrid_tests.cc)
-foreach(_t manufactured corrosion bad_input rank_invariance)
+foreach(_t manufactured corrosion bad_input rank_invariance layer_rows_skipped)
   perideal_add_test(NAME hybrid.${_t} COMMAND $<TARGET_FILE:hybrid_tests> ${_t} LABELS unit)
 endforeach()
 # Run time of standard vs hybrid at dx = 1/160 (printed, not asserted).

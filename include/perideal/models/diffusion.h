@@ -155,6 +155,24 @@ namespace PeriDEAL
     void
     apply(const Vector &C, Vector &rate, const Vector *phase = nullptr) const;
 
+    /** Which rows apply() computes. */
+    enum class Rows
+    {
+      /** Every owned row, also those of the volume-constraint layer. */
+      all,
+      /**
+       * Only the owned interior rows; the entries of @p rate at the
+       * volume-constraint layer are left untouched. For time steppers that
+       * overwrite the layer with prescribed values (DiffusionSolver): in 3D
+       * the layer can hold more nodes than the body (doc/design.md).
+       */
+      interior
+    };
+
+    /** apply() restricted to @p rows; bitwise the same values on those rows. */
+    void
+    apply(const Vector &C, Vector &rate, const Vector *phase, const Rows rows) const;
+
     /**
      * Largest forward Euler step the Gershgorin theorem proves stable for
      * this boundary treatment: min_i 2 / (|l_ii| + R_i) over the rows of the
@@ -237,6 +255,8 @@ namespace PeriDEAL
     /** Hybrid: WLS rows (Omega_w) and a per-owned-node flag; empty if none. */
     std::unique_ptr<WlsQuadrature<dim>> wls;
     std::vector<unsigned char>          is_wls;
+    /** Owned interior rows that use the standard scheme (Rows::interior). */
+    std::vector<unsigned int> interior_standard_rows;
 
     /** |l_ii| + R_i and l_ii <= 0 && R_i <= |l_ii| of WLS row k. */
     std::pair<double, bool>
