@@ -17,6 +17,8 @@
 
 #include <perideal/time_stepping/mechanics_solver.h>
 
+#include "../../tests/hybrid_kw/kalthoff_winkler_case.h"
+
 #include <cstdlib>
 #include <iomanip>
 #include <iostream>
@@ -25,44 +27,6 @@
 using namespace dealii;
 using namespace PeriDEAL;
 
-namespace
-{
-  MechanicsRunParameters<2>
-  kalthoff_winkler(const double dx, const double delta, const double end_time,
-                   const std::string &quadrature, const double sigma, const std::string &dir)
-  {
-    MechanicsRunParameters<2> p;
-    p.domain = std::make_shared<BoxDomain<2>>(Point<2>(0., -100.), Point<2>(100., 100.));
-    p.lattice.dx            = dx;
-    p.lattice.delta         = delta;
-    p.lattice.cell_centered = true;
-    p.model.omega           = InfluenceFunction::constant;
-    p.model.youngs_modulus  = 190e3;
-    p.model.plane_stress    = false;
-    p.model.fracture_energy = 22.17;
-    p.density               = 8e-9;
-    p.initial_velocity      = "0; 0";
-    p.body_force            = "0; 0";
-    typename MechanicsRunParameters<2>::Region v;
-    v.level_set             = "max(x - " + std::to_string(dx) + ", abs(y) - 25)";
-    v.value                 = "16.5e3; 0";
-    p.prescribed_velocities = {v};
-    p.precracks = {{Point<2>(-1., 25.), Point<2>(50., 25.)}, {Point<2>(-1., -25.), Point<2>(50., -25.)}};
-    p.measure_crack        = true;
-    p.crack_origin         = Point<2>(50., 25.);
-    p.crack_region         = "max(50 - x, 25 - y)";
-    p.crack_fit_min_radius = delta;
-    p.crack_fit_max_radius = 50.;
-    p.time_step            = 0.;
-    p.end_time             = end_time;
-    p.output_directory     = dir;
-    p.time_series_interval = 100000000;
-    p.progress_interval    = 1e9;
-    p.quadrature           = quadrature;
-    p.hybrid.sigma         = sigma;
-    return p;
-  }
-} // namespace
 
 int
 main(int argc, char **argv)
@@ -98,13 +62,13 @@ main(int argc, char **argv)
   // Hybrid first: its time step bound (WLS symbol) is the smaller one, and
   // both runs use it.
   Timer              setup_timer(MPI_COMM_WORLD, true);
-  auto ph = kalthoff_winkler(dx, delta, end_time, "hybrid adaptive", sigma, dir + "/hybrid");
+  auto ph = kalthoff_winkler(dx, delta, end_time, "hybrid adaptive", sigma, dir + "/hybrid", 100000000);
   ph.hybrid.check_interval = interval;
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = setup_timer.wall_time();
   const double initial      = hybrid.hybrid_model()->standard_fraction();
-  auto ps = kalthoff_winkler(dx, delta, end_time, "standard", sigma, dir + "/standard");
+  auto ps = kalthoff_winkler(dx, delta, end_time, "standard", sigma, dir + "/standard", 100000000);
   ps.time_step = hybrid.integrator().time_step();
   setup_timer.restart();
   MechanicsSolver<2> standard(MPI_COMM_WORLD, ps);

@@ -18,6 +18,7 @@
 #include <perideal/time_stepping/mechanics_solver.h>
 
 #include "../check.h"
+#include "kalthoff_winkler_case.h"
 
 #include <map>
 
@@ -129,45 +130,6 @@ namespace
     // the few-percent quadrature error known for m = 4.
     check(err[0] <= 0.1, "quadratic field, standard bulk nodes (quadrature error): " +
                            sci(err[0]) + " <= 0.1");
-  }
-
-  // The Kalthoff-Winkler setup of tutorial/step-4 (plate 100 x 200 mm,
-  // pre-cracks at y = +-25 from x = 0 to 50, v0 = 16.5 m/s between them,
-  // steel, G0 = 22.17 N/mm, plane strain, omega_0, cell-centred lattice).
-  MechanicsRunParameters<2>
-  kalthoff_winkler(const double dx, const double delta, const double end_time,
-                   const std::string &quadrature, const double sigma, const std::string &dir)
-  {
-    MechanicsRunParameters<2> p;
-    p.domain                 = std::make_shared<BoxDomain<2>>(Point<2>(0., -100.), Point<2>(100., 100.));
-    p.lattice.dx             = dx;
-    p.lattice.delta          = delta;
-    p.lattice.cell_centered  = true;
-    p.model.omega            = InfluenceFunction::constant;
-    p.model.youngs_modulus   = 190e3;
-    p.model.plane_stress     = false;
-    p.model.fracture_energy  = 22.17;
-    p.density                = 8e-9;
-    p.initial_velocity       = "0; 0";
-    p.body_force             = "0; 0";
-    typename MechanicsRunParameters<2>::Region v;
-    v.level_set = "max(x - " + std::to_string(dx) + ", abs(y) - 25)";
-    v.value     = "16.5e3; 0";
-    p.prescribed_velocities = {v};
-    p.precracks = {{Point<2>(-1., 25.), Point<2>(50., 25.)}, {Point<2>(-1., -25.), Point<2>(50., -25.)}};
-    p.measure_crack         = true;
-    p.crack_origin          = Point<2>(50., 25.);
-    p.crack_region          = "max(50 - x, 25 - y)";
-    p.crack_fit_min_radius  = delta;
-    p.crack_fit_max_radius  = 50.;
-    p.time_step             = 0.;
-    p.end_time              = end_time;
-    p.output_directory      = dir;
-    p.time_series_interval  = 1000000;
-    p.progress_interval     = 1e9;
-    p.quadrature            = quadrature;
-    p.hybrid.sigma          = sigma;
-    return p;
   }
 
   // Damage of the owned nodes keyed by node id.
