@@ -32,6 +32,17 @@ namespace PeriDEAL
       {
         return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
       }
+
+      // Node i's vector of an interleaved dim-component field.
+      template <int dim>
+      Tensor<1, dim>
+      node_vector(const std::vector<double> &field, const unsigned int i)
+      {
+        Tensor<1, dim> w;
+        for (unsigned int d = 0; d < dim; ++d)
+          w[d] = field[dim * i + d];
+        return w;
+      }
     } // namespace
 
     MechanicsModel
@@ -956,30 +967,21 @@ namespace PeriDEAL
     Tensor<1, dim>
     MechanicsSolver<dim>::displacement(const Grid g, const unsigned int i) const
     {
-      Tensor<1, dim> w;
-      for (unsigned int d = 0; d < dim; ++d)
-        w[d] = u[g][dim * i + d];
-      return w;
+      return node_vector<dim>(u[g], i);
     }
 
     template <int dim>
     Tensor<1, dim>
     MechanicsSolver<dim>::velocity(const Grid g, const unsigned int i) const
     {
-      Tensor<1, dim> w;
-      for (unsigned int d = 0; d < dim; ++d)
-        w[d] = v[g][dim * i + d];
-      return w;
+      return node_vector<dim>(v[g], i);
     }
 
     template <int dim>
     Tensor<1, dim>
     MechanicsSolver<dim>::acceleration(const Grid g, const unsigned int i) const
     {
-      Tensor<1, dim> w;
-      for (unsigned int d = 0; d < dim; ++d)
-        w[d] = a[g][dim * i + d];
-      return w;
+      return node_vector<dim>(a[g], i);
     }
 
     template <int dim>

@@ -265,15 +265,6 @@ namespace
     const double cp     = std::sqrt(9. / 8.);
     // Rounded to whole dx so that both lattices coincide.
     const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta) / c.dx) * c.dx;
-    if (std::getenv("EL_ONLY_ABC"))
-      {
-        // Exploration: the energy of the ABC run alone.
-        const auto h = run_case(c, c.R, ElasticTruncation::absorbing, prm);
-        for (unsigned int s = 0; s < h.times.size(); ++s)
-          if (root())
-            std::cout << "    t = " << h.times[s] << " total/E0 " << sci(h.total[s] / h.total[0]) << std::endl;
-        return;
-      }
     const auto   ref    = run_case(c, radius, ElasticTruncation::free, prm);
     const auto   abc    = run_case(c, c.R, ElasticTruncation::absorbing, prm);
     const auto   free   = run_case(c, c.R, ElasticTruncation::free, prm);

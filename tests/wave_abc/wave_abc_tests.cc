@@ -30,7 +30,8 @@ using namespace PeriDEALTests;
 
 namespace
 {
-  /** Environment override of a numeric test parameter (exploration only). */  double
+  /** Environment override of a numeric test parameter (exploration only). */
+  double
   env(const char *name, const double fallback)
   {
     return std::getenv(name) ? std::atof(std::getenv(name)) : fallback;
@@ -351,8 +352,7 @@ namespace
     WaveAbcParameters prm;
     prm.wave_number_range = M_PI / 2.;
     prm.dispersion        = "discrete";
-    if (std::getenv("WAVE_VMAX"))
-      prm.max_update_norm = std::atof(std::getenv("WAVE_VMAX"));
+    prm.max_update_norm = env("WAVE_VMAX", prm.max_update_norm);
     if (std::getenv("WAVE_DISP"))
       prm.dispersion = std::getenv("WAVE_DISP");
     prm.n_time_levels = env("WAVE_LEVELS", 2);
@@ -421,9 +421,9 @@ namespace
   void
   pd_2d()
   {
-    const double R = std::getenv("WAVE_R") ? std::atof(std::getenv("WAVE_R")) : 8.;
-    const double T = std::getenv("WAVE_T") ? std::atof(std::getenv("WAVE_T")) : 2. * R;
-    const int    m = std::getenv("WAVE_M") ? std::atoi(std::getenv("WAVE_M")) : 6;
+    const double R = env("WAVE_R", 8.);
+    const double T = env("WAVE_T", 2. * R);
+    const int    m = static_cast<int>(env("WAVE_M", 6));
     LatticeParameters lp;
     lp.dx    = 0.25;
     lp.delta = m * lp.dx;
@@ -431,7 +431,7 @@ namespace
     mp.exponent   = 2.;
     mp.wave_speed = 1.;
     mp.damping    = 0.0125;
-    mp.time_step  = std::getenv("WAVE_DT") ? std::atof(std::getenv("WAVE_DT")) : 0.02;
+    mp.time_step  = env("WAVE_DT", 0.02);
     const ScalarFunctionFromFunctionObject<2> u0(
       [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
     const auto inner = [&](const Point<2> &p) { return p.norm() < R - lp.delta - 1e-9; };
@@ -444,31 +444,15 @@ namespace
     // A wider extrapolation cone than the source's pi/4 (measured: the
     // growth of late-time errors starts later, see doc/design.md).
     prm.cone_angle        = 0.5;
-    prm.wave_number_range = std::getenv("WAVE_DK") ? std::atof(std::getenv("WAVE_DK")) : 1.;
-    if (std::getenv("WAVE_VMAX"))
-      prm.max_update_norm = std::atof(std::getenv("WAVE_VMAX"));
-    if (std::getenv("WAVE_NK"))
-      prm.n_wave_numbers = std::atoi(std::getenv("WAVE_NK"));
-    if (std::getenv("WAVE_CR"))
-      prm.cloud_radius = std::atof(std::getenv("WAVE_CR"));
-    if (std::getenv("WAVE_CONE"))
-      prm.cone_angle = std::atof(std::getenv("WAVE_CONE"));
-    if (std::getenv("WAVE_DPHI"))
-      prm.direction_range = std::atof(std::getenv("WAVE_DPHI"));
-    if (std::getenv("WAVE_NPHI"))
-      prm.n_directions = std::atoi(std::getenv("WAVE_NPHI"));
-    if (std::getenv("WAVE_TOL"))
-      prm.pseudo_inverse_tolerance = std::atof(std::getenv("WAVE_TOL"));
-    if (std::getenv("WAVE_LAYER"))
-      prm.layer_thickness = std::atof(std::getenv("WAVE_LAYER"));
-    if (std::getenv("WAVE_ONLY_A"))
-      {
-        const auto A = simulate<2>(near, lp, mp, WaveTruncation::absorbing, prm, u0, T, 20, inner, false);
-        for (unsigned int s = 0; s < A.times.size(); ++s)
-          if (root())
-            std::cout << "    t = " << A.times[s] << " E/E0 " << sci(A.total_energy[s] / A.total_energy[0]) << std::endl;
-        return;
-      }
+    prm.wave_number_range = env("WAVE_DK", 1.);
+    prm.max_update_norm = env("WAVE_VMAX", prm.max_update_norm);
+    prm.n_wave_numbers = static_cast<unsigned int>(env("WAVE_NK", prm.n_wave_numbers));
+    prm.cloud_radius = env("WAVE_CR", prm.cloud_radius);
+    prm.cone_angle = env("WAVE_CONE", prm.cone_angle);
+    prm.direction_range = env("WAVE_DPHI", prm.direction_range);
+    prm.n_directions = static_cast<unsigned int>(env("WAVE_NPHI", prm.n_directions));
+    prm.pseudo_inverse_tolerance = env("WAVE_TOL", prm.pseudo_inverse_tolerance);
+    prm.layer_thickness = env("WAVE_LAYER", prm.layer_thickness);
     const unsigned int n_samples = 8;
     const auto ref  = simulate<2>(far, lp, mp, WaveTruncation::free, prm, u0, T, n_samples, inner);
     const auto free = simulate<2>(near, lp, mp, WaveTruncation::free, prm, u0, T, n_samples, inner);
@@ -493,8 +477,6 @@ namespace
                 << " energy increase " << sci(max_energy_increase(A.total_energy)) << " abc fraction " << A.abc_fraction << "\n"
                 << "    B: cond " << sci(B.stats.max_condition_number) << " max|V| " << sci(B.stats.max_update_norm)
                 << " thinned " << B.stats.n_thinned << " energy increase " << sci(max_energy_increase(B.total_energy)) << std::endl;
-    if (std::getenv("WAVE_NO_CHECK"))
-      return;
     for (const auto *h : {&A, &B})
       check(h->stats.max_condition_number <= 1e12 && h->stats.max_update_norm <= 2., "guards: cond <= 1e12, max|V| <= 2");
     const double a_field = field_difference(A.fields.back(), ref.fields.back(), lp.dx) / norm0;
@@ -543,9 +525,9 @@ namespace
   void
   fem_2d()
   {
-    const double L = std::getenv("WAVE_L") ? std::atof(std::getenv("WAVE_L")) : 8.;
+    const double L = env("WAVE_L", 8.);
     const double h = 0.5, T = 2. * L;
-    const unsigned int degree = std::getenv("WAVE_DEG") ? std::atoi(std::getenv("WAVE_DEG")) : 1;
+    const unsigned int degree = static_cast<unsigned int>(env("WAVE_DEG", 1));
     Fem::FemWaveParameters fp;
     fp.degree    = degree;
     fp.damping   = 0.0125;
@@ -560,10 +542,8 @@ namespace
     GridGenerator::subdivided_hyper_cube(far, static_cast<unsigned int>(std::round(2. * L_ref / h)), -L_ref, L_ref);
     WaveAbcParameters prm;
     prm.cone_angle = 0.5;
-    if (std::getenv("WAVE_CONE"))
-      prm.cone_angle = std::atof(std::getenv("WAVE_CONE"));
-    if (std::getenv("WAVE_CR"))
-      prm.cloud_radius = std::atof(std::getenv("WAVE_CR"));
+    prm.cone_angle = env("WAVE_CONE", prm.cone_angle);
+    prm.cloud_radius = env("WAVE_CR", prm.cloud_radius);
     const auto inside = [&](const Point<2> &p) { return std::max(std::abs(p[0]), std::abs(p[1])) < L - h; };
     Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, prm, u0);
     Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, prm, u0);
@@ -598,8 +578,6 @@ namespace
                         << " first-order " << sci(first.value_at(probe) - ur) << std::endl;
           }
       }
-    if (std::getenv("WAVE_NO_CHECK"))
-      return;
     check(st.max_condition_number <= 1e12 && st.max_update_norm <= 2., "EBF guards hold");
     // The source's E13 claim (proposed ABC reflects visibly less than the
     // first-order ABC) is NOT reproduced by this FEM set-up: measured max
@@ -722,7 +700,7 @@ namespace
         if (nb == 5)
           {
             const auto norm = [&]() { return pd.displacement().l2_norm(); };
-            const unsigned int n_transient = std::getenv("WAVE_STEPS") ? std::atoi(std::getenv("WAVE_STEPS")) : 25000;
+            const unsigned int n_transient = static_cast<unsigned int>(env("WAVE_STEPS", 25000));
             for (unsigned int s = 0; s < n_transient; ++s)
               {
                 pd.advance();
