@@ -1,0 +1,433 @@
+// Tests of the distributed multi-grid on the octree (MultiGrid::OctreeMultiGrid,
+// dissertation Sect. 3.4 on p4est with MPI):
+//  serial_2d / serial_3d: fixed fine region, pure diffusion, node-by-node
+//    against the independent serial MultiGrid::TransportSolver (both
+//    couplings), and mass conservation of the conservative coupling;
+//  switching: a corrosion run whose coarse cells switch to fine, with the
+//    mass jump at the switches and the node counts;
+//  ranks (NPROCS 2): the same switching run on 2 ranks against 1 rank;
+//  corrosion_2d: solid-volume history of the adaptive octree multi-grid
+//    against the uniform-fine (serial) model, with the uniform-coarse model
+//    as the scale of the discretization error;
+//  bad_input: ParameterErrors.
+
+#include <deal.II/base/timer.h>
+
+#include <perideal/base/exceptions.h>
+#include <perideal/multigrid/multigrid_discretization.h>
+#include <perideal/multigrid/octree_multigrid.h>
+
+#include "../check.h"
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <vector>
+
+using namespace dealii;
+using namespace PeriDEAL;
+using namespace PeriDEALTests;
+
+namespace
+{
+  template <int dim>
+  Point<dim>
+  uniform_point(const double v)
+  {
+    Point<dim> p;
+    for (unsigned int d = 0; d < dim; ++d)
+      p[d] = v;
+    return p;
+  }
+
+  // Serial run: (id -> C) of the active nodes after n steps, the mass history.
+  template <int dim, typename F>
+  std::map<std::uint64_t, double>
+  serial_run(const MultiGrid::Parameters<dim>        &p,
+             const MultiGrid::TransportParameters     &tp,
+             const F                                  &c0,
+             const unsigned int                        n_steps,
+             const MultiGrid::OctreeMultiGrid<dim>    &ids,
+             std::vector<double>                      &mass)
+  {
+    const MultiGrid::Discretization<dim> disc(p);
+    MultiGrid::TransportSolver<dim>      s(disc, tp);
+    s.set_initial(c0);
+    mass = {s.mass()};
+    for (unsigned int n = 0; n < n_steps; ++n)
+      {
+        s.advance();
+        mass.push_back(s.mass());
+      }
+    std::map<std::uint64_t, double> out;
+    for (unsigned int i = 0; i < disc.n_active(); ++i)
+      out[ids.node_id(disc.position[i], disc.grid[i] == disc.fine)] = s.solution()[i];
+    return out;
+  }
+
+  // Octree vs serial on a fixed fine region (the union of octree cells).
+  template <int dim>
+  void
+  serial_comparison(const double half_width, const double delta, const double fine_dx,
+                    const double region_lower, const double region_upper,
+                    const unsigned int n_steps)
+  {
+    MultiGrid::Parameters<dim> p;
+    p.lower       = uniform_point<dim>(-half_width);
+    p.upper       = uniform_point<dim>(half_width);
+    p.coarse_dx   = 0.5;
+    p.fine_dx     = fine_dx;
+    p.delta       = delta;
+    p.fine_region = MultiGrid::Region<dim>::box(uniform_point<dim>(region_lower),
+                                                uniform_point<dim>(region_upper));
+    Point<dim> x0;
+    x0[0] = 0.4;
+    x0[1] = -0.3;
+    // a bump across the grid interface
+    auto c0 = [&](const Point<dim> &x) { return std::exp(-x.distance_square(x0) / 2.); };
+
+    for (const bool conservative : {false, true})
+      {
+        MultiGrid::TransportParameters tp;
+        tp.kappa        = 1.;
+        tp.conservative = conservative;
+        // 0.7 x the serial solver's bound: the octree's conservative bound
+        // does not merge duplicate entries of a row and is up to ~25 % lower
+        {
+          const MultiGrid::Discretization<dim> d(p);
+          tp.time_step = 0.7 * MultiGrid::TransportSolver<dim>(d, tp).critical_time_step();
+        }
+        MultiGrid::OctreeParameters<dim> op;
+        op.grid      = p;
+        op.transport = tp;
+        MultiGrid::OctreeMultiGrid<dim> mg(MPI_COMM_WORLD, op);
+        mg.set_initial(c0);
+        const double m0 = mg.mass();
+        for (unsigned int n = 0; n < n_steps; ++n)
+          mg.advance();
+        const auto mine = mg.gather();
+        std::vector<double> serial_mass;
+        const auto serial = serial_run<dim>(p, tp, c0, n_steps, mg, serial_mass);
+        const auto na     = mg.n_active();
+        if (root())
+          {
+            double max_diff = 0.;
+            bool   same_set = mine.size() == serial.size();
+            for (const auto &[id, c, ph] : mine)
+              {
+                const auto it = serial.find(id);
+                same_set      = same_set && it != serial.end();
+                if (it != serial.end())
+                  max_diff = std::max(max_diff, std::abs(c - it->second));
+              }
+            const std::string tag = std::string(conservative ? "conservative" : "interpolation") +
+                                    " coupling, " + std::to_string(dim) + "D: ";
+            std::cout << "  " << tag << na[0] << " coarse + " << na[1] << " fine active nodes, "
+                      << mg.n_fine_cells() << " fine cells, dt " << mg.time_step()
+                      << " (octree bound " << mg.critical_time_step() << ")" << std::endl;
+            check(same_set, tag + "same active node set as the serial multi-grid");
+            // round-off: the same bonds, weights and summation order per row
+            check(max_diff < 1e-13, tag + "max |C_octree - C_serial| = " + sci(max_diff) +
+                                      " < 1e-13 after " + std::to_string(n_steps) + " steps");
+          }
+        const double m1 = mg.mass();
+        const double serial_drift =
+          std::abs(serial_mass.back() - serial_mass.front()) / serial_mass.front();
+        if (conservative)
+          // the pay-back makes every interface flux antisymmetric: round-off only
+          check(std::abs(m1 - m0) / m0 < 1e-13,
+                "conservative coupling: relative mass change " + sci(std::abs(m1 - m0) / m0) +
+                  " < 1e-13 (serial: " + sci(serial_drift) + ")");
+        else
+          // the interpolation coupling is not conservative (see
+          // TransportParameters::conservative); it drifts as the serial one
+          check_close(std::abs(m1 - m0) / m0, serial_drift, 1e-6,
+                      "interpolation coupling: relative mass drift equals the serial one");
+      }
+  }
+
+  void
+  serial_2d()
+  {
+    // 12 x 12 box, delta = 1, dx+ = 0.5, dx- = 0.125 (r = 4); octree cells
+    // of 4 dx+ = 2, the fine region the 2 x 2 cells around the origin
+    serial_comparison<2>(6., 1., 0.125, -2.1, 1.6, 200);
+  }
+
+  void
+  serial_3d()
+  {
+    // 6^3 box, delta = 0.75, dx+ = 0.5, dx- = 0.25; one fine octree cell
+    serial_comparison<3>(3., 0.75, 0.25, -1.1, 0.6, 40);
+  }
+
+  // The 2D corrosion case: a solid disk (C = 1) of radius 2 in a liquid
+  // square (C = 0) with no-flux (free nonlocal) boundary; material of E5.
+  struct Corrosion2d
+  {
+    double half_width = 6., radius = 2., delta = 1., fine_dx = 0.25;
+    MultiGrid::Parameters<2> grid(const double region_radius) const
+    {
+      MultiGrid::Parameters<2> p;
+      p.lower       = uniform_point<2>(-half_width);
+      p.upper       = uniform_point<2>(half_width);
+      p.coarse_dx   = 0.5;
+      p.fine_dx     = fine_dx;
+      p.delta       = delta;
+      p.fine_region = region_radius > 0. ?
+                        MultiGrid::Region<2>::ball(Point<2>(), region_radius) :
+                        MultiGrid::Region<2>();
+      return p;
+    }
+    MultiGrid::TransportParameters transport(const bool conservative) const
+    {
+      MultiGrid::TransportParameters tp;
+      tp.corrosion       = true;
+      tp.kappa_liquid    = 2.;
+      tp.kappa_interface = 0.1;
+      tp.saturation      = 0.85;
+      tp.conservative    = conservative;
+      return tp;
+    }
+    double c0(const Point<2> &x) const
+    {
+      return x.norm() <= radius ? 1. : 0.;
+    }
+  };
+
+  // adaptive octree run: fine region starts at the solid, grows by switching
+  MultiGrid::OctreeParameters<2>
+  switching_parameters(const Corrosion2d &c, const bool conservative, const double dt)
+  {
+    MultiGrid::OctreeParameters<2> op;
+    op.grid                = c.grid(c.radius);
+    op.transport           = c.transport(conservative);
+    op.transport.time_step = dt;
+    op.switching           = true;
+    op.indicator_threshold = 0.02;
+    op.switching_interval  = 20;
+    return op;
+  }
+
+  // the uniform-fine bound of the case: every grid is at most as stiff
+  double
+  corrosion_time_step(const Corrosion2d &c)
+  {
+    const MultiGrid::Discretization<2> d(c.grid(100.));
+    return MultiGrid::TransportSolver<2>(d, c.transport(false)).time_step();
+  }
+
+  void
+  switching()
+  {
+    const Corrosion2d c;
+    const double      dt = 0.5 * corrosion_time_step(c);
+    for (const bool conservative : {false, true})
+      {
+        MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, switching_parameters(c, conservative, dt));
+        mg.set_initial([&](const Point<2> &x) { return c.c0(x); });
+        const unsigned int cells0 = mg.n_fine_cells();
+        const auto         n0     = mg.n_active();
+        const double       v0     = mg.active_volume();
+        double             mass_prev = mg.mass(), max_step_change = 0., max_switch_jump = 0.;
+        unsigned int       switches = 0;
+        for (unsigned int n = 0; n < 400; ++n)
+          {
+            const unsigned int s0 = mg.n_switches();
+            mg.advance();
+            const double m = mg.mass();
+            (mg.n_switches() > s0 ? max_switch_jump : max_step_change) =
+              std::max(mg.n_switches() > s0 ? max_switch_jump : max_step_change,
+                       std::abs(m - mass_prev) / mass_prev);
+            switches  = mg.n_switches();
+            mass_prev = m;
+          }
+        const auto         n1   = mg.n_active();
+        const std::string  tag  = conservative ? "conservative: " : "interpolation: ";
+        if (root())
+          std::cout << "  " << tag << "fine cells " << cells0 << " -> " << mg.n_fine_cells()
+                    << " in " << switches << " switch events; active nodes " << n0[0] << "+"
+                    << n0[1] << " -> " << n1[0] << "+" << n1[1] << ", fictitious "
+                    << mg.n_fictitious() << "; max relative mass change per step "
+                    << sci(max_step_change) << ", at a switch " << sci(max_switch_jump)
+                    << "; solid volume " << mg.solid_volume() << std::endl;
+        check(switches > 0 && mg.n_fine_cells() > cells0,
+              tag + "coarse cells switched to fine as the front spread");
+        check_close(mg.active_volume(), v0, 1e-14,
+                    tag + "active volume unchanged by switching (counted once)");
+        if (conservative)
+          {
+            check(max_step_change < 1e-13,
+                  tag + "mass conserved to round-off between switches: " +
+                    sci(max_step_change));
+            // switching interpolates C into the new fine nodes; in a cell
+            // where C is linear the d-linear/IDW interpolation of a cell-
+            // centred lattice preserves the cell mass, the residual is the
+            // curvature of C over dx+: measured 1e-5..1e-4 relative here
+            check(max_switch_jump < 1e-3,
+                  tag + "mass change at a switch " + sci(max_switch_jump) + " < 1e-3");
+          }
+      }
+  }
+
+  void
+  ranks()
+  {
+    // the switching run on all ranks vs on rank 0 alone
+    const Corrosion2d c;
+    const double      dt = 0.5 * corrosion_time_step(c);
+    for (const bool conservative : {false, true})
+      {
+        auto run = [&](const MPI_Comm comm, double &imbalance, unsigned int &cells,
+                       unsigned int &switches) {
+          MultiGrid::OctreeMultiGrid<2> mg(comm, switching_parameters(c, conservative, dt));
+          mg.set_initial([&](const Point<2> &x) { return c.c0(x); });
+          for (unsigned int n = 0; n < 200; ++n)
+            mg.advance();
+          imbalance = mg.bond_imbalance();
+          cells     = mg.n_fine_cells();
+          switches  = mg.n_switches();
+          return mg.gather();
+        };
+        double       imb_n, imb_1;
+        unsigned int cells_n, cells_1, sw_n, sw_1;
+        const auto   all = run(MPI_COMM_WORLD, imb_n, cells_n, sw_n);
+        if (!root())
+          continue;
+        const auto   one = run(MPI_COMM_SELF, imb_1, cells_1, sw_1);
+        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        double max_diff = 0.;
+        bool   same     = all.size() == one.size();
+        for (std::size_t q = 0; same && q < all.size(); ++q)
+          {
+            same     = std::get<0>(all[q]) == std::get<0>(one[q]) &&
+                   std::get<2>(all[q]) == std::get<2>(one[q]);
+            max_diff = std::max(max_diff, std::abs(std::get<1>(all[q]) - std::get<1>(one[q])));
+          }
+        std::cout << "  " << tag << Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)
+                  << " ranks: " << all.size() << " active nodes, " << cells_n
+                  << " fine cells after " << sw_n << " switches, bond imbalance max/mean "
+                  << imb_n << std::endl;
+        check(sw_n > 0 && sw_n == sw_1 && cells_n == cells_1,
+              tag + "the same switches on 1 and n ranks");
+        check(same, tag + "the same node ids and phases on 1 and n ranks");
+        // interpolation coupling: every row sums in lattice order -> bit for
+        // bit; conservative: the pay-back of remote rows is summed in
+        // another order -> round-off
+        check(max_diff <= (conservative ? 1e-13 : 0.),
+              tag + "max |C_n - C_1| = " + sci(max_diff));
+      }
+  }
+
+  void
+  corrosion_2d()
+  {
+    const Corrosion2d c;
+    const double      dt      = 0.5 * corrosion_time_step(c);
+    const unsigned int n_steps = 2400, every = 200;
+    auto serial = [&](const double region) {
+      const MultiGrid::Discretization<2> d(c.grid(region));
+      auto                               tp = c.transport(false);
+      tp.time_step                          = dt;
+      MultiGrid::TransportSolver<2> s(d, tp);
+      s.set_initial([&](const Point<2> &x) { return c.c0(x); });
+      std::vector<double> v{s.solid_volume()};
+      for (unsigned int n = 1; n <= n_steps; ++n)
+        {
+          s.advance();
+          if (n % every == 0)
+            v.push_back(s.solid_volume());
+        }
+      return v;
+    };
+    const auto fine   = serial(100.); // every coarse cell refined: uniform fine
+    const auto coarse = serial(0.);   // no fine region: uniform coarse
+    for (const bool conservative : {false, true})
+      {
+        Timer                         timer;
+        MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, switching_parameters(c, conservative, dt));
+        mg.set_initial([&](const Point<2> &x) { return c.c0(x); });
+        std::vector<double> v{mg.solid_volume()};
+        for (unsigned int n = 1; n <= n_steps; ++n)
+          {
+            mg.advance();
+            if (n % every == 0)
+              v.push_back(mg.solid_volume());
+          }
+        const auto   na  = mg.n_active();
+        double       err = 0., err_coarse = 0.;
+        if (root())
+          std::cout << "  t   V_s/V_s0: uniform fine | octree MG ("
+                    << (conservative ? "conservative" : "interpolation") << ") | uniform coarse"
+                    << std::endl;
+        for (std::size_t q = 0; q < v.size(); ++q)
+          {
+            err        = std::max(err, std::abs(v[q] / v[0] - fine[q] / fine[0]));
+            err_coarse = std::max(err_coarse, std::abs(coarse[q] / coarse[0] - fine[q] / fine[0]));
+            if (root())
+              std::cout << "  " << q * every * dt << "  " << fine[q] / fine[0] << "  "
+                        << v[q] / v[0] << "  " << coarse[q] / coarse[0] << std::endl;
+          }
+        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        if (root())
+          std::cout << "  " << tag << "final active nodes " << na[0] << " coarse + " << na[1]
+                    << " fine (uniform fine: " << std::pow(2 * c.half_width / 0.5 + 1, 2) * 4
+                    << "), " << mg.n_fine_cells() << " fine cells, " << mg.n_switches()
+                    << " switch events, " << timer.wall_time() << " s" << std::endl;
+        check(fine.back() < 0.9 * fine.front(), "the uniform-fine solid lost > 10 % by the end");
+        // tolerance: 0.02 of V_s(0), i.e. ~ the volume of one ring of fine
+        // nodes (2 pi r dx- / (pi r^2) = 0.25) / 12; the uniform-coarse model
+        // sets the scale of the discretization error
+        check(err < 0.02, tag + "max |V_s/V_s0 (octree MG) - (uniform fine)| = " + sci(err) +
+                            " < 0.02 (uniform coarse: " + sci(err_coarse) + ")");
+        check(err < 0.5 * err_coarse,
+              tag + "octree MG at least 2x closer to uniform fine than uniform coarse");
+      }
+  }
+
+  void
+  bad_input()
+  {
+    const Corrosion2d c;
+    auto              throws = [](const MultiGrid::OctreeParameters<2> &op, const std::string &what) {
+      bool thrown = false;
+      try
+        {
+          MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, op);
+        }
+      catch (const ParameterError &e)
+        {
+          thrown = true;
+          if (root())
+            std::cout << "  " << e.what() << std::endl;
+        }
+      check(thrown, what + " -> ParameterError");
+    };
+    auto op                = switching_parameters(c, true, 0.);
+    op.grid.interpolation  = MultiGrid::Interpolation::nearest_active;
+    throws(op, "nearest-active interpolation");
+    op                     = switching_parameters(c, true, 0.);
+    op.transport.scheme    = "backward Euler";
+    throws(op, "backward Euler");
+    op                     = switching_parameters(c, true, 0.);
+    op.indicator_threshold = 0.;
+    throws(op, "indicator threshold 0");
+    op                     = switching_parameters(c, true, 10.);
+    throws(op, "time step above the forward Euler bound");
+    op                     = switching_parameters(c, true, 0.);
+    op.grid.fine_dx        = 0.3;
+    throws(op, "dx+ not a multiple of dx-");
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  return run(argc, argv,
+             {{"serial_2d", serial_2d},
+              {"serial_3d", serial_3d},
+              {"switching", switching},
+              {"ranks", ranks},
+              {"corrosion_2d", corrosion_2d},
+              {"bad_input", bad_input}});
+}
