@@ -724,13 +724,13 @@ namespace PeriDEAL
     unsigned int
     OctreeMultiGrid<dim>::adapt()
     {
-      // 1. indicator on owned coarse cells: range of C over the active
-      // nodes of the cell and its neighbours (all local after the exchange)
+      // 1. indicator on owned coarse cells: range of C over the cell's
+      // active nodes
       std::map<long long, std::pair<double, double>> block_range; // local blocks
       {
         std::vector<Index> nodes;
         for (const auto &cell : tria.active_cell_iterators())
-          if (!cell->is_artificial())
+          if (cell->is_locally_owned())
             {
               const long long b = block_of_cell(cell);
               block_nodes(b, block_fine[b], nodes);
@@ -765,15 +765,9 @@ namespace PeriDEAL
       for (const auto &cell : tria.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            const long long b  = block_of_cell(cell);
-            double          lo = std::numeric_limits<double>::infinity(), hi = -lo;
-            for (const long long n : neighbours(b))
-              {
-                const auto &r = block_range.at(n);
-                lo            = std::min(lo, r.first);
-                hi            = std::max(hi, r.second);
-              }
-            critical[b] = hi - lo > prm.indicator_threshold;
+            const long long b = block_of_cell(cell);
+            const auto     &r = block_range.at(b);
+            critical[b]       = !block_fine[b] && r.second - r.first > prm.indicator_threshold;
           }
       MPI_Allreduce(MPI_IN_PLACE, critical.data(), critical.size(), MPI_INT, MPI_MAX, comm);
       std::vector<char> new_fine = block_fine;
@@ -844,6 +838,26 @@ namespace PeriDEAL
                         }
                     v[nodes.size() + q] = ph >= 0.5 ? 1. : 0.;
                   }
+              if (new_fine[b] != block_fine[b] && !nodes.empty())
+                {
+                  // mass bookkeeping: shift the r^dim fine values of each
+                  // coarse cell so that their mean is the coarse value
+                  // (exact for linear C already; the shift removes the
+                  // curvature error, so switching conserves mass)
+                  std::vector<Index> coarse;
+                  block_nodes(b, false, coarse);
+                  const std::size_t r_dim = nodes.size() / coarse.size();
+                  for (std::size_t K = 0; K < coarse.size(); ++K)
+                    {
+                      const double c_K = C.local_element(local_of_id.at(id_of(false, coarse[K])));
+                      double       mean = 0.;
+                      for (std::size_t s = 0; s < r_dim; ++s)
+                        mean += v[K * r_dim + s];
+                      mean /= r_dim;
+                      for (std::size_t s = 0; s < r_dim; ++s)
+                        v[K * r_dim + s] += c_K - mean;
+                    }
+                }
             }
       }
 

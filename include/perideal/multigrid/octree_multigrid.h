@@ -35,12 +35,12 @@ namespace PeriDEAL
       Parameters<dim>     grid;
       TransportParameters transport;
       /**
-       * Switch coarse cells to fine during the run: a cell is critical when
-       * the range max C - min C over the active nodes of the cell and of its
-       * neighbour cells exceeds @p indicator_threshold (a front or a steep
-       * gradient is near); critical cells and their neighbours (a buffer of
-       * one cell, so that a front arrives in an already fine region) become
-       * fine. Fine cells stay fine.
+       * Switch coarse cells to fine during the run: a coarse cell is
+       * critical when the range max C - min C over its active nodes exceeds
+       * @p indicator_threshold (a front or a steep gradient has arrived);
+       * critical cells and their neighbours (a buffer of one cell, so that
+       * the front moves on into an already fine region) become fine. Fine
+       * cells stay fine.
        */
       bool         switching           = false;
       double       indicator_threshold = 0.05;
@@ -82,7 +82,10 @@ namespace PeriDEAL
      *
      * Switching (adapt()): critical coarse cells become fine; their fine
      * nodes take the values of the fine fictitious interpolation from the
-     * coarse grid (phase: interpolated, solid iff >= 1/2). The mesh is then
+     * coarse grid, shifted per coarse cell so that the mean of its r^dim
+     * fine values is the coarse value (the switch conserves mass to
+     * round-off; linear fields are unchanged by the shift); phase:
+     * interpolated, solid iff >= 1/2. The mesh is then
      * repartitioned with weight (1 + bonds of the cell's active nodes), the
      * node values travel with their cell (register_data_attach), and the
      * numbering, ghosts, bonds and interpolation are rebuilt.
