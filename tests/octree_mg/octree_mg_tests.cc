@@ -161,22 +161,28 @@ namespace
     serial_comparison<3>(3., 0.75, 0.25, -1.1, 0.6, 40);
   }
 
-  // The 2D corrosion case: a solid disk (C = 1) of radius 2 in a liquid
-  // square (C = 0) with no-flux (free nonlocal) boundary; material of E5.
-  struct Corrosion2d
+  // The corrosion case: a solid disk/ball (C = 1) in a liquid square/cube
+  // (C = 0) with no-flux (free nonlocal) boundary; material of E5. 2D: radius
+  // 3 in [-12, 12]^2, delta = 1; 3D (rank test only): radius 1 at (-1.5,
+  // -1.5, -1.5) in [-3, 3]^3, delta = 0.5 (octree cells of 1.5: 5^3);
+  // dx+ = 0.5, dx- = 0.25.
+  template <int dim>
+  struct CorrosionCase
   {
-    double half_width = 12., radius = 3., delta = 1., fine_dx = 0.25;
-    MultiGrid::Parameters<2> grid(const double region_radius) const
+    double     half_width = dim == 2 ? 12. : 3., radius = dim == 2 ? 3. : 1.,
+           delta = dim == 2 ? 1. : 0.5, fine_dx = 0.25;
+    Point<dim> centre = dim == 2 ? Point<dim>() : uniform_point<dim>(-1.5);
+    MultiGrid::Parameters<dim> grid(const double region_radius) const
     {
-      MultiGrid::Parameters<2> p;
-      p.lower       = uniform_point<2>(-half_width);
-      p.upper       = uniform_point<2>(half_width);
+      MultiGrid::Parameters<dim> p;
+      p.lower       = uniform_point<dim>(-half_width);
+      p.upper       = uniform_point<dim>(half_width);
       p.coarse_dx   = 0.5;
       p.fine_dx     = fine_dx;
       p.delta       = delta;
       p.fine_region = region_radius > 0. ?
-                        MultiGrid::Region<2>::ball(Point<2>(), region_radius) :
-                        MultiGrid::Region<2>();
+                        MultiGrid::Region<dim>::ball(centre, region_radius) :
+                        MultiGrid::Region<dim>();
       return p;
     }
     MultiGrid::TransportParameters transport(const bool conservative) const
@@ -189,17 +195,18 @@ namespace
       tp.conservative    = conservative;
       return tp;
     }
-    double c0(const Point<2> &x) const
+    double c0(const Point<dim> &x) const
     {
-      return x.norm() <= radius ? 1. : 0.;
+      return x.distance(centre) <= radius ? 1. : 0.;
     }
   };
 
   // adaptive octree run: fine region starts at the solid, grows by switching
-  MultiGrid::OctreeParameters<2>
-  switching_parameters(const Corrosion2d &c, const bool conservative, const double dt)
+  template <int dim>
+  MultiGrid::OctreeParameters<dim>
+  switching_parameters(const CorrosionCase<dim> &c, const bool conservative, const double dt)
   {
-    MultiGrid::OctreeParameters<2> op;
+    MultiGrid::OctreeParameters<dim> op;
     op.grid                = c.grid(c.radius);
     op.transport           = c.transport(conservative);
     op.transport.time_step = dt;
@@ -210,17 +217,18 @@ namespace
   }
 
   // the uniform-fine bound of the case: every grid is at most as stiff
+  template <int dim>
   double
-  corrosion_time_step(const Corrosion2d &c)
+  corrosion_time_step(const CorrosionCase<dim> &c)
   {
-    const MultiGrid::Discretization<2> d(c.grid(100.));
-    return MultiGrid::TransportSolver<2>(d, c.transport(false)).time_step();
+    const MultiGrid::Discretization<dim> d(c.grid(100.));
+    return MultiGrid::TransportSolver<dim>(d, c.transport(false)).time_step();
   }
 
   void
   switching()
   {
-    const Corrosion2d c;
+    const CorrosionCase<2> c;
     const double      dt = 0.5 * corrosion_time_step(c);
     for (const bool conservative : {false, true})
       {
@@ -268,19 +276,20 @@ namespace
       }
   }
 
+  template <int dim>
   void
-  ranks()
+  ranks_dim(const unsigned int n_steps)
   {
     // the switching run on all ranks vs on rank 0 alone
-    const Corrosion2d c;
+    const CorrosionCase<dim> c;
     const double      dt = 0.5 * corrosion_time_step(c);
     for (const bool conservative : {false, true})
       {
         auto run = [&](const MPI_Comm comm, double &imbalance, unsigned int &cells,
                        unsigned int &switches) {
-          MultiGrid::OctreeMultiGrid<2> mg(comm, switching_parameters(c, conservative, dt));
-          mg.set_initial([&](const Point<2> &x) { return c.c0(x); });
-          for (unsigned int n = 0; n < 200; ++n)
+          MultiGrid::OctreeMultiGrid<dim> mg(comm, switching_parameters(c, conservative, dt));
+          mg.set_initial([&](const Point<dim> &x) { return c.c0(x); });
+          for (unsigned int n = 0; n < n_steps; ++n)
             mg.advance();
           imbalance = mg.bond_imbalance();
           cells     = mg.n_fine_cells();
@@ -293,7 +302,8 @@ namespace
         if (!root())
           continue;
         const auto   one = run(MPI_COMM_SELF, imb_1, cells_1, sw_1);
-        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        const std::string tag = std::to_string(dim) + "D " +
+                                (conservative ? "conservative: " : "interpolation: ");
         double max_diff = 0.;
         bool   same     = all.size() == one.size();
         for (std::size_t q = 0; same && q < all.size(); ++q)
@@ -318,9 +328,16 @@ namespace
   }
 
   void
+  ranks()
+  {
+    ranks_dim<2>(200);
+    ranks_dim<3>(40);
+  }
+
+  void
   corrosion_2d()
   {
-    const Corrosion2d c;
+    const CorrosionCase<2> c;
     const double      dt      = 0.5 * corrosion_time_step(c);
     const unsigned int n_steps = 200, every = 10;
     auto serial = [&](const double region) {
@@ -386,7 +403,7 @@ namespace
   void
   bad_input()
   {
-    const Corrosion2d c;
+    const CorrosionCase<2> c;
     auto              throws = [](const MultiGrid::OctreeParameters<2> &op, const std::string &what) {
       bool thrown = false;
       try
