@@ -6,6 +6,7 @@
 
 #include <perideal/base/exceptions.h>
 #include <perideal/discretization/discretization.h>
+#include <perideal/multigrid/lattice_tools.h>
 #include <perideal/multigrid/octree_multigrid.h>
 
 #include <algorithm>
@@ -48,48 +49,19 @@ namespace PeriDEAL
     namespace
     {
       template <int dim>
-      using Idx = std::array<long long, dim>;
+      using Idx = Lattice::Index<dim>;
+      using Lattice::in_range;
+      using Lattice::unravel;
 
       template <int dim>
       long long
       linear_index(const Idx<dim> &i, const Idx<dim> &n)
       {
-        long long k = 0;
-        for (int d = dim - 1; d >= 0; --d)
-          k = k * n[d] + i[d];
-        return k;
+        return Lattice::linear<dim>(i, n);
       }
 
-      template <int dim>
-      Idx<dim>
-      unravel(long long k, const Idx<dim> &n)
-      {
-        Idx<dim> i;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            i[d] = k % n[d];
-            k /= n[d];
-          }
-        return i;
-      }
-
-      template <int dim>
-      bool
-      inside(const Idx<dim> &i, const Idx<dim> &n)
-      {
-        for (unsigned int d = 0; d < dim; ++d)
-          if (i[d] < 0 || i[d] >= n[d])
-            return false;
-        return true;
-      }
-
-      /**
-       * Interpolation of a point x from the lattice {origin + i s}, i in
-       * [0, n): the deduplicated corners of the enclosing lattice cell
-       * (clamped at the lattice ends) and their weights, (3.85)-(3.88) or
-       * d-linear; the same corners, order and formulas as the serial
-       * MultiGrid::Discretization, so both give the same numbers.
-       */
+      // corners of x's cell in the lattice {origin + i s}, i in [0, n), and
+      // their weights: the serial multi-grid's rule (Lattice helpers)
       template <int dim>
       void
       corner_interpolation(const Point<dim>      &x,
@@ -100,57 +72,17 @@ namespace PeriDEAL
                            std::vector<Idx<dim>> &corners,
                            std::vector<double>   &weights)
       {
-        Idx<dim>                base;
-        std::array<double, dim> t;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const double y = (x[d] - origin[d]) / s;
-            base[d]        = (long long)std::floor(y + 1e-10);
-            t[d]           = y - base[d];
-            if (std::abs(t[d]) < 1e-10)
-              t[d] = 0.;
-            if (base[d] < 0)
-              base[d] = 0, t[d] = 0.;
-            if (base[d] >= n[d] - 1)
-              base[d] = n[d] - 1, t[d] = 0.;
-          }
-        corners.clear();
-        weights.clear();
-        std::vector<double> dist;
-        for (unsigned int c = 0; c < (1u << dim); ++c)
-          {
-            Idx<dim> i;
-            double   w    = 1.;
-            bool     skip = false;
-            Point<dim> p;
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                const bool up = (c >> d) & 1u;
-                skip          = skip || (up && t[d] == 0.);
-                i[d]          = base[d] + (up ? 1 : 0);
-                w *= up ? t[d] : 1. - t[d];
-                p[d] = origin[d] + i[d] * s;
-              }
-            if (skip)
-              continue;
-            corners.push_back(i);
-            weights.push_back(w);
-            dist.push_back(x.distance(p));
-          }
-        if (scheme == Interpolation::multilinear)
-          return;
-        for (unsigned int j = 0; j < corners.size(); ++j)
-          if (dist[j] < 1e-10 * s)
-            {
-              std::fill(weights.begin(), weights.end(), 0.);
-              weights[j] = 1.;
-              return;
-            }
-        double sum = 0.;
-        for (unsigned int j = 0; j < corners.size(); ++j)
-          sum += (weights[j] = 1. / dist[j]);
-        for (double &w : weights)
-          w /= sum;
+        std::vector<double> multilinear;
+        Lattice::enclosing_corners<dim>(x, origin, s, n, corners, multilinear);
+        std::vector<Point<dim>> points(corners.size());
+        for (unsigned int c = 0; c < corners.size(); ++c)
+          for (unsigned int d = 0; d < dim; ++d)
+            points[c][d] = origin[d] + corners[c][d] * s;
+        Lattice::corner_weights<dim>(x, points, multilinear,
+                                     scheme == Interpolation::multilinear ?
+                                       Interpolation::multilinear :
+                                       Interpolation::inverse_distance,
+                                     s, weights);
       }
     } // namespace
 
@@ -193,39 +125,17 @@ namespace PeriDEAL
       for (const unsigned int fine : {0u, 1u})
         {
           // offsets with beta > 0 in the serial code's order (d = 0 fastest)
-          const double    s     = fine ? h : H;
-          const long long reach = (long long)std::ceil((g.delta + 0.5 * s) / s) + 1;
-          const long long n     = 2 * reach + 1;
-          long long       total = 1;
-          for (unsigned int d = 0; d < dim; ++d)
-            total *= n;
-          double m2 = 0.;
-          for (long long q = 0; q < total; ++q)
+          const double s = fine ? h : H;
+          stencil[fine]  = Lattice::stencil<dim>(s, g.delta, g.partial_volume);
+          double m2      = 0.;
+          for (const auto &[o, r] : stencil[fine])
             {
-              Index     o;
-              long long rest = q;
-              double    r2   = 0.;
-              bool      zero = true;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  o[d] = rest % n - reach;
-                  rest /= n;
-                  r2 += double(o[d] * o[d]) * s * s;
-                  zero = zero && o[d] == 0;
-                }
-              if (zero)
-                continue;
-              const double r = std::sqrt(r2);
-              const double beta =
-                PeriDEAL::Discretization<dim>::volume_factor(r, g.delta, s, g.partial_volume);
-              if (beta > 0.)
-                {
-                  stencil[fine].emplace_back(o, r);
-                  // as DiffusionOperator: omega at min(r, delta) in the shell
-                  stencil_weight[fine].push_back(kernel(std::min(r, g.delta)) * beta *
-                                                 std::pow(s, dim));
-                  m2 += stencil_weight[fine].back() * double(o[0] * o[0]) * s * s;
-                }
+              // as DiffusionOperator: omega at min(r, delta) in the shell
+              stencil_weight[fine].push_back(
+                kernel(std::min(r, g.delta)) *
+                PeriDEAL::Discretization<dim>::volume_factor(r, g.delta, s, g.partial_volume) *
+                std::pow(s, dim));
+              m2 += stencil_weight[fine].back() * double(o[0] * o[0]) * s * s;
             }
           if (prm.transport.calibrate)
             for (double &w : stencil_weight[fine])
@@ -482,7 +392,7 @@ namespace PeriDEAL
               Index j;
               for (unsigned int d = 0; d < dim; ++d)
                 j[d] = lattice[a][d] + stencil[fine][e].first[d];
-              if (!inside<dim>(j, n))
+              if (!in_range<dim>(j, n))
                 continue; // beyond the body: no bond (free nonlocal boundary)
               col.push_back(node_of(fine, j));
               bond_entry.push_back(e);
@@ -756,7 +666,7 @@ namespace PeriDEAL
                 N[d] = B[d] + int(rest % 3) - 1;
                 rest /= 3;
               }
-            if (inside<dim>(N, n_blocks))
+            if (in_range<dim>(N, n_blocks))
               out.push_back(linear_index<dim>(N, n_blocks));
           }
         return out;
