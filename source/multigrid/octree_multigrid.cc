@@ -803,32 +803,34 @@ namespace PeriDEAL
 
     template <int dim>
     double
-    OctreeMultiGrid<dim>::mass() const
+    OctreeMultiGrid<dim>::integrate(const LinearAlgebra::distributed::Vector<double> *v) const
     {
+      // active nodes only: each region's mass is counted in one grid
       double s = 0.;
       for (unsigned int i = 0; i < n_owned; ++i)
-        s += C.local_element(i) * std::pow(node_fine[i] ? h : H, dim);
+        s += (v ? v->local_element(i) : 1.) * std::pow(node_fine[i] ? h : H, dim);
       return Utilities::MPI::sum(s, comm);
+    }
+
+    template <int dim>
+    double
+    OctreeMultiGrid<dim>::mass() const
+    {
+      return integrate(&C);
     }
 
     template <int dim>
     double
     OctreeMultiGrid<dim>::solid_volume() const
     {
-      double s = 0.;
-      for (unsigned int i = 0; i < n_owned; ++i)
-        s += phase.local_element(i) * std::pow(node_fine[i] ? h : H, dim);
-      return Utilities::MPI::sum(s, comm);
+      return integrate(&phase);
     }
 
     template <int dim>
     double
     OctreeMultiGrid<dim>::active_volume() const
     {
-      double s = 0.;
-      for (unsigned int i = 0; i < n_owned; ++i)
-        s += std::pow(node_fine[i] ? h : H, dim);
-      return Utilities::MPI::sum(s, comm);
+      return integrate(nullptr);
     }
 
     template <int dim>

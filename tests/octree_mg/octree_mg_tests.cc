@@ -334,6 +334,23 @@ namespace
     ranks_dim<3>(40);
   }
 
+  // V_s at steps 0, every, 2 every, ... of a serial or octree solver
+  template <typename Solver>
+  std::vector<double>
+  solid_volume_history(Solver &s, const CorrosionCase<2> &c, const unsigned int n_steps,
+                       const unsigned int every)
+  {
+    s.set_initial([&](const Point<2> &x) { return c.c0(x); });
+    std::vector<double> v{s.solid_volume()};
+    for (unsigned int n = 1; n <= n_steps; ++n)
+      {
+        s.advance();
+        if (n % every == 0)
+          v.push_back(s.solid_volume());
+      }
+    return v;
+  }
+
   void
   corrosion_2d()
   {
@@ -345,15 +362,7 @@ namespace
       auto                               tp = c.transport(false);
       tp.time_step                          = dt;
       MultiGrid::TransportSolver<2> s(d, tp);
-      s.set_initial([&](const Point<2> &x) { return c.c0(x); });
-      std::vector<double> v{s.solid_volume()};
-      for (unsigned int n = 1; n <= n_steps; ++n)
-        {
-          s.advance();
-          if (n % every == 0)
-            v.push_back(s.solid_volume());
-        }
-      return v;
+      return solid_volume_history(s, c, n_steps, every);
     };
     const auto fine   = serial(100.); // every coarse cell refined: uniform fine
     const auto coarse = serial(0.);   // no fine region: uniform coarse
@@ -361,14 +370,7 @@ namespace
       {
         Timer                         timer;
         MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, switching_parameters(c, conservative, dt));
-        mg.set_initial([&](const Point<2> &x) { return c.c0(x); });
-        std::vector<double> v{mg.solid_volume()};
-        for (unsigned int n = 1; n <= n_steps; ++n)
-          {
-            mg.advance();
-            if (n % every == 0)
-              v.push_back(mg.solid_volume());
-          }
+        const auto v = solid_volume_history(mg, c, n_steps, every);
         const auto   na  = mg.n_active();
         double       err = 0., err_coarse = 0.;
         if (root())

@@ -179,6 +179,9 @@ namespace PeriDEAL
       node_id(const Point<dim> &x, const bool fine) const;
 
     private:
+      /** sum over owned active nodes of v_i V_i (V_i if @p v is null). */
+      double
+      integrate(const LinearAlgebra::distributed::Vector<double> *v) const;
       void
       build(const std::unordered_map<long long, std::vector<double>> *values);
       void
