@@ -6,9 +6,9 @@
 //  switching: a corrosion run whose coarse cells switch to fine, with the
 //    mass jump at the switches and the node counts;
 //  ranks (NPROCS 2): the same switching run on 2 ranks against 1 rank;
-//  corrosion_2d: solid-volume history of the adaptive octree multi-grid
-//    against the uniform-fine (serial) model, with the uniform-coarse model
-//    as the scale of the discretization error;
+//  corrosion_2d / corrosion_3d: solid-volume history of the adaptive octree
+//    multi-grid against the uniform-fine (serial) model, with the
+//    uniform-coarse model as the scale of the discretization error;
 //  bad_input: ParameterErrors.
 
 #include <deal.II/base/timer.h>
@@ -349,12 +349,12 @@ namespace
   }
 
   // V_s at steps 0, every, 2 every, ... of a serial or octree solver
-  template <typename Solver>
+  template <int dim, typename Solver>
   std::vector<double>
-  solid_volume_history(Solver &s, const CorrosionCase<2> &c, const unsigned int n_steps,
+  solid_volume_history(Solver &s, const CorrosionCase<dim> &c, const unsigned int n_steps,
                        const unsigned int every)
   {
-    s.set_initial([&](const Point<2> &x) { return c.c0(x); });
+    s.set_initial([&](const Point<dim> &x) { return c.c0(x); });
     std::vector<double> v{s.solid_volume()};
     for (unsigned int n = 1; n <= n_steps; ++n)
       {
@@ -365,18 +365,18 @@ namespace
     return v;
   }
 
+  template <int dim>
   void
-  corrosion_2d()
+  corrosion(const unsigned int n_steps, const unsigned int every)
   {
-    const CorrosionCase<2> c;
+    const CorrosionCase<dim> c;
     const double      dt      = 0.5 * corrosion_time_step(c);
-    const unsigned int n_steps = 200, every = 10;
     auto serial = [&](const double region) {
-      const MultiGrid::Discretization<2> d(c.grid(region));
+      const MultiGrid::Discretization<dim> d(c.grid(region));
       auto                               tp = c.transport(false);
       tp.time_step                          = dt;
-      MultiGrid::TransportSolver<2> s(d, tp);
-      return solid_volume_history(s, c, n_steps, every);
+      MultiGrid::TransportSolver<dim> s(d, tp);
+      return solid_volume_history(s, c, n_steps, 1);
     };
     Timer      timer;
     const auto fine     = serial(100.); // every coarse cell refined: uniform fine
@@ -385,38 +385,64 @@ namespace
     for (const bool conservative : {false, true})
       {
         timer.restart();
-        MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, switching_parameters(c, conservative, dt));
-        const auto v = solid_volume_history(mg, c, n_steps, every);
+        MultiGrid::OctreeMultiGrid<dim> mg(MPI_COMM_WORLD, switching_parameters(c, conservative, dt));
+        const auto v = solid_volume_history(mg, c, n_steps, 1);
         const auto   na  = mg.n_active();
-        double       err = 0., err_coarse = 0.;
+        // the histories are step functions (the solid loses whole nodes,
+        // in 2D/3D symmetric groups of 4/8): compare them by the relative
+        // L1 norm over the run, sum_n |V_s^n/V_s^0 - ref| / sum_n ref,
+        // which weighs a late group by how late it is
+        double err = 0., err_coarse = 0., norm = 0., max_dev = 0.;
         if (root())
           std::cout << "  t   V_s/V_s0: uniform fine | octree MG ("
                     << (conservative ? "conservative" : "interpolation") << ") | uniform coarse"
                     << std::endl;
         for (std::size_t q = 0; q < v.size(); ++q)
           {
-            err        = std::max(err, std::abs(v[q] / v[0] - fine[q] / fine[0]));
-            err_coarse = std::max(err_coarse, std::abs(coarse[q] / coarse[0] - fine[q] / fine[0]));
-            if (root())
-              std::cout << "  " << q * every * dt << "  " << fine[q] / fine[0] << "  "
+            err += std::abs(v[q] / v[0] - fine[q] / fine[0]);
+            err_coarse += std::abs(coarse[q] / coarse[0] - fine[q] / fine[0]);
+            norm += fine[q] / fine[0];
+            max_dev = std::max(max_dev, std::abs(v[q] / v[0] - fine[q] / fine[0]));
+            if (root() && q % every == 0)
+              std::cout << "  " << q * dt << "  " << fine[q] / fine[0] << "  "
                         << v[q] / v[0] << "  " << coarse[q] / coarse[0] << std::endl;
           }
-        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        err /= norm;
+        err_coarse /= norm;
+        const std::string tag = std::to_string(dim) + "D " +
+                                (conservative ? "conservative: " : "interpolation: ");
         if (root())
           std::cout << "  " << tag << "final active nodes " << na[0] << " coarse + " << na[1]
-                    << " fine (uniform fine: " << std::pow(2 * c.half_width / 0.5 + 1, 2) * 4
+                    << " fine (uniform fine: " << std::pow(2 * c.half_width / 0.5 + 1, dim) * std::pow(2, dim)
                     << "), " << mg.n_fine_cells() << " fine cells, " << mg.n_switches()
                     << " switch events; CPU " << timer.cpu_time() << " s (serial uniform fine "
                     << fine_cpu << " s)" << std::endl;
-        check(fine.back() < 0.9 * fine.front(), "the uniform-fine solid lost > 10 % by the end");
-        // tolerance: 0.02 of V_s(0), i.e. ~ the volume of one ring of fine
-        // nodes (2 pi r dx- / (pi r^2) = 0.25) / 12; the uniform-coarse model
-        // sets the scale of the discretization error
-        check(err < 0.02, tag + "max |V_s/V_s0 (octree MG) - (uniform fine)| = " + sci(err) +
-                            " < 0.02 (uniform coarse: " + sci(err_coarse) + ")");
-        check(err < 0.5 * err_coarse,
-              tag + "octree MG at least 2x closer to uniform fine than uniform coarse");
+        check(fine.back() < 0.1 * fine.front(), "the uniform-fine solid lost > 90 % by the end");
+        // tolerance: the solid dissolves by symmetric groups of nodes, in 2D
+        // 4-8 of ~450 (1-2 % of V_s0), in 3D 8-48 of ~280 (3-17 %); 0.02
+        // resp. 0.05 is about one group late over the whole run. The main
+        // criterion is relative: the uniform-coarse model sets the scale of
+        // the discretization error, and the multi-grid must be well inside
+        const double tol = dim == 2 ? 0.02 : 0.05;
+        check(err < tol, tag + "relative L1 distance of the V_s histories, octree MG vs "
+                               "uniform fine " + sci(err) + " < " + sci(tol) +
+                           " (uniform coarse: " + sci(err_coarse) +
+                           "; max pointwise deviation " + sci(max_dev) + ")");
+        check(err < 0.25 * err_coarse,
+              tag + "octree MG at least 4x closer to uniform fine than uniform coarse");
       }
+  }
+
+  void
+  corrosion_2d()
+  {
+    corrosion<2>(200, 10);
+  }
+
+  void
+  corrosion_3d()
+  {
+    corrosion<3>(60, 5);
   }
 
   void
@@ -463,5 +489,6 @@ main(int argc, char **argv)
               {"switching", switching},
               {"ranks", ranks},
               {"corrosion_2d", corrosion_2d},
+              {"corrosion_3d", corrosion_3d},
               {"bad_input", bad_input}});
 }

@@ -1,6 +1,6 @@
 perideal_add_test_program(octree_mg_tests ${CMAKE_CURRENT_LIST_DIR}/octree_mg_tests.cc)
 
-foreach(_t serial_2d serial_3d switching corrosion_2d bad_input)
+foreach(_t serial_2d serial_3d switching corrosion_2d corrosion_3d bad_input)
   perideal_add_test(NAME octree_mg.${_t} COMMAND $<TARGET_FILE:octree_mg_tests> ${_t}
     LABELS unit)
 endforeach()
