@@ -40,6 +40,20 @@ namespace
     return p;
   }
 
+  // the cube [-L, L]^dim with dx+ = 0.5 (no fine region yet)
+  template <int dim>
+  MultiGrid::Parameters<dim>
+  box_parameters(const double half_width, const double delta, const double fine_dx)
+  {
+    MultiGrid::Parameters<dim> p;
+    p.lower     = uniform_point<dim>(-half_width);
+    p.upper     = uniform_point<dim>(half_width);
+    p.coarse_dx = 0.5;
+    p.fine_dx   = fine_dx;
+    p.delta     = delta;
+    return p;
+  }
+
   // Serial run: (id -> C) of the active nodes after n steps, the mass history.
   template <int dim, typename F>
   std::map<std::uint64_t, double>
@@ -72,12 +86,7 @@ namespace
                     const double region_lower, const double region_upper,
                     const unsigned int n_steps)
   {
-    MultiGrid::Parameters<dim> p;
-    p.lower       = uniform_point<dim>(-half_width);
-    p.upper       = uniform_point<dim>(half_width);
-    p.coarse_dx   = 0.5;
-    p.fine_dx     = fine_dx;
-    p.delta       = delta;
+    auto p        = box_parameters<dim>(half_width, delta, fine_dx);
     p.fine_region = MultiGrid::Region<dim>::box(uniform_point<dim>(region_lower),
                                                 uniform_point<dim>(region_upper));
     Point<dim> x0;
@@ -188,12 +197,7 @@ namespace
     Point<dim> centre = dim == 2 ? Point<dim>() : uniform_point<dim>(-1.5);
     MultiGrid::Parameters<dim> grid(const double region_radius) const
     {
-      MultiGrid::Parameters<dim> p;
-      p.lower       = uniform_point<dim>(-half_width);
-      p.upper       = uniform_point<dim>(half_width);
-      p.coarse_dx   = 0.5;
-      p.fine_dx     = fine_dx;
-      p.delta       = delta;
+      auto p        = box_parameters<dim>(half_width, delta, fine_dx);
       p.fine_region = region_radius > 0. ?
                         MultiGrid::Region<dim>::ball(centre, region_radius) :
                         MultiGrid::Region<dim>();
