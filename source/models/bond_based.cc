@@ -964,21 +964,25 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  Point<dim>
+  BondBasedOperator<dim>::deformation_origin() const
+  {
+    std::array<int, dim> mid;
+    for (unsigned int d = 0; d < dim; ++d)
+      mid[d] = int(disc.lattice_size()[d] / 2);
+    return disc.lattice_point(mid);
+  }
+
+  template <int dim>
   void
   BondBasedOperator<dim>::sweep_forces(const VectorField &u, VectorField &force)
   {
-#ifdef PERIDEAL_PMB_AVX512
-    if (!sweep_bits_valid)
-      build_sweep_bits();
     const std::vector<Point<dim>> &x       = disc.position;
     const unsigned int             n_owned = disc.n_owned();
     const std::size_t              N       = sweep_n_alloc;
     // Deformed positions x - x_c + u as in the list loops (bitwise the same
     // values), one array per component over the box.
-    std::array<int, dim> mid;
-    for (unsigned int d = 0; d < dim; ++d)
-      mid[d] = int(disc.lattice_size()[d] / 2);
-    const Point<dim> xc = disc.lattice_point(mid);
+    const Point<dim> xc = deformation_origin();
     for (unsigned int d = 0; d < dim; ++d)
       {
         double       *pd = sweep_p.data() + d * N;
@@ -986,24 +990,45 @@ namespace PeriDEAL
         for (std::size_t i = 0; i < x.size(); ++i)
           pd[sweep_position[i]] = (x[i][d] - xc[d]) + ud[i];
       }
+    lattice_sweep_forces(sweep_p.data(), [&](const std::size_t  c0,
+                                             const unsigned int   n,
+                                             const double        *f,
+                                             const unsigned int   C) {
+      const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
+      for (std::size_t L = c0; L < c1; ++L)
+        {
+          const std::int32_t i = sweep_node[L];
+          if (i >= 0 && i < std::int32_t(n_owned))
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(i) = f[d * C + L - c0];
+        }
+    });
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::lattice_sweep_forces(const double *p, const SweepChunkFinish &finish)
+  {
+#ifdef PERIDEAL_PMB_AVX512
+    AssertThrow(uses_lattice_sweep(), ExcMessage("The lattice sweep is not in use."));
+    if (!sweep_bits_valid)
+      build_sweep_bits();
+    const unsigned int n_owned = disc.n_owned();
+    const std::size_t  N       = sweep_n_alloc;
     sweep_broken.clear();
     // Chunks of C box positions, all offsets per chunk: the chunk's
     // positions, forces and the reactions it reaches (up to the largest
     // offset beyond it) stay in L2. A position's force is final once its
-    // chunk is done (reactions come from lower positions only).
+    // chunk is done (reactions come from lower positions only). The
+    // reaction array is zero between calls: each chunk clears what it
+    // consumed (no separate memset pass).
     constexpr unsigned int C = 512;
     alignas(64) double     a[dim * C];
-    const std::int64_t     o_max  = sweep_offset.back();
     const std::size_t      n_bits = 8 * sweep_n_bytes;
     double                *R      = sweep_reaction.data();
-    std::size_t            zeroed = 0;
     for (std::size_t c0 = 0; c0 < n_bits; c0 += C)
       {
-        const unsigned int n    = std::min<std::size_t>(C, n_bits - c0);
-        const std::size_t  need = std::min<std::size_t>(N, c0 + n + o_max + 8);
-        for (unsigned int d = 0; d < dim; ++d)
-          std::fill(R + d * N + zeroed, R + d * N + need, 0.);
-        zeroed = std::max(zeroed, need);
+        const unsigned int n = std::min<std::size_t>(C, n_bits - c0);
         std::fill(a, a + dim * C, 0.);
         // Two offsets per pass (shared p_L loads and force updates): h and
         // h + n_pairs, which lie in different lattice lines.
@@ -1011,26 +1036,31 @@ namespace PeriDEAL
         for (unsigned int h = 0; h < n_pairs; ++h)
           {
             const unsigned int hs[2] = {h, h + n_pairs};
-            sweep_offsets_avx512<dim, 2>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
-                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
-                                         sweep_r.data(), s0, sweep_broken);
+            sweep_offsets_avx512<dim, 2>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
+                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
+                                         s0, sweep_broken);
           }
         if (n_half % 2)
           {
             const unsigned int hs[1] = {n_half - 1};
-            sweep_offsets_avx512<dim, 1>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
-                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
-                                         sweep_r.data(), s0, sweep_broken);
+            sweep_offsets_avx512<dim, 1>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
+                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
+                                         s0, sweep_broken);
           }
-        const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
-        for (std::size_t L = c0; L < c1; ++L)
+        for (unsigned int d = 0; d < dim; ++d)
           {
-            const std::int32_t i = sweep_node[L];
-            if (i >= 0 && i < std::int32_t(n_owned))
-              for (unsigned int d = 0; d < dim; ++d)
-                force[d].local_element(i) = a[d * C + L - c0] - R[d * N + L];
+            double *ad = a + d * C, *Rd = R + d * N + c0;
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                ad[k] -= Rd[k];
+                Rd[k] = 0.;
+              }
           }
+        finish(c0, n, a, C);
       }
+    // Reactions that landed beyond the last chunk (on no node).
+    for (unsigned int d = 0; d < dim; ++d)
+      std::fill(R + d * N + n_bits, R + (d + 1) * N, 0.);
     // Flag the CSR copies of the newly broken bonds (rare).
     const unsigned int centre = centre_index();
     for (const auto &[h, L] : sweep_broken)
@@ -1042,9 +1072,9 @@ namespace PeriDEAL
           broken_flag[find_bond(upper, 2 * centre - sweep_box_index[h])] = 1;
       }
 #else
-    (void)u;
-    (void)force;
-    Assert(false, ExcInternalError());
+    (void)p;
+    (void)finish;
+    AssertThrow(false, ExcMessage("The lattice sweep is not compiled."));
 #endif
   }
 
@@ -1071,10 +1101,7 @@ namespace PeriDEAL
         const std::size_t  n_local = x.size();
         constexpr unsigned int R   = node_stride<dim>;
         deformed.assign(n_local * R, 0.);
-        std::array<int, dim> mid;
-        for (unsigned int d = 0; d < dim; ++d)
-          mid[d] = int(disc.lattice_size()[d] / 2);
-        const Point<dim> xc = disc.lattice_point(mid);
+        const Point<dim> xc = deformation_origin();
         for (unsigned int d = 0; d < dim; ++d)
           {
             const double *ud = u[d].begin();

@@ -104,6 +104,13 @@ namespace PeriDEAL
         return s.str();
       }
 
+      /** The wrapped operator. */
+      Operator &
+      wrapped() const
+      {
+        return op;
+      }
+
     private:
       Operator &op;
     };
@@ -132,6 +139,7 @@ namespace PeriDEAL
     , disc(op.discretization())
     , rho(density)
     , dt(time_step)
+    , sweep_model(&op)
   {
     setup();
   }
@@ -145,6 +153,8 @@ namespace PeriDEAL
     , rho(density)
     , dt(time_step)
   {
+    if (auto *a = dynamic_cast<Adapter<dim, BondBasedOperator<dim>> *>(&model))
+      sweep_model = &a->wrapped();
     setup();
   }
 
@@ -341,6 +351,203 @@ namespace PeriDEAL
     // Prescribed nodes have a = 0, so their velocity stays as set.
     t += dt;
     ++n_steps;
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::advance(const unsigned int n)
+  {
+    if (n > 1 && uses_box_state())
+      advance_in_box(n);
+    else
+      for (unsigned int s = 0; s < n; ++s)
+        advance();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::advance_in_box(const unsigned int n_now)
+  {
+    BondBasedOperator<dim>           &op      = *sweep_model;
+    const std::size_t                 N       = op.lattice_sweep_stride();
+    const std::size_t                 E       = op.lattice_sweep_extent();
+    const std::vector<std::uint32_t> &pos     = op.lattice_sweep_positions();
+    const unsigned int                n_owned = disc.n_owned();
+    const std::size_t                 n_local = disc.position.size();
+    const Point<dim>                  xc      = op.deformation_origin();
+    const double                      inv_rho = 1. / rho;
+    const bool parallel = Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1;
+
+    // Load the node vectors into the box (empty positions: all zero). The
+    // first half-kick uses the stored a^n (box_f holds it until the first
+    // force evaluation); held nodes have w = 0, so the kicks leave them.
+    bool has_body = bool(body_force_function);
+    for (unsigned int d = 0; d < dim; ++d)
+      for (unsigned int i = 0; i < n_owned; ++i)
+        has_body = has_body || body_force[d].local_element(i) != 0.;
+    for (std::vector<double> *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
+      b->assign(dim * N, 0.);
+    box_w.assign(N, 0.);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      box_w[pos[i]] = is_held(i) ? 0. : inv_rho;
+    std::vector<unsigned int> velocity_nodes;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (prescribed_set[i] >= 0)
+        velocity_nodes.push_back(i);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double *u = box_u.data() + d * N, *x = box_x.data() + d * N, *p = box_p.data() + d * N;
+        for (std::size_t i = 0; i < n_local; ++i)
+          {
+            x[pos[i]] = disc.position[i][d] - xc[d];
+            u[pos[i]] = displacement[d].local_element(i);
+            p[pos[i]] = x[pos[i]] + u[pos[i]];
+          }
+        double *v = box_v.data() + d * N, *f = box_f.data() + d * N, *b = box_b.data() + d * N;
+        for (unsigned int i = 0; i < n_owned; ++i)
+          {
+            v[pos[i]] = velocity[d].local_element(i);
+            f[pos[i]] = acceleration[d].local_element(i);
+            b[pos[i]] = body_force[d].local_element(i);
+          }
+      }
+
+    const double *w = box_w.data();
+    // The second half-kick, per chunk of final forces: a = w (F + b).
+    const auto kick = [&](const std::size_t c0, const unsigned int n, const double *fc,
+                          const unsigned int C) {
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          double       *f  = box_f.data() + d * N + c0;
+          double       *v  = box_v.data() + d * N + c0;
+          const double *b  = box_b.data() + d * N + c0;
+          const double *wc = w + c0;
+          const double *fd = fc + d * C;
+          if (has_body)
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                f[k]           = fd[k];
+                const double a = wc[k] * (fd[k] + b[k]);
+                v[k] += 0.5 * dt * a;
+              }
+          else
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                f[k]           = fd[k];
+                const double a = wc[k] * fd[k];
+                v[k] += 0.5 * dt * a;
+              }
+        }
+    };
+
+    for (unsigned int s = 0; s < n_now; ++s)
+      {
+        // Held nodes before the drift (as in advance()).
+        for (const unsigned int i : displacement_nodes)
+          if (displacement_set[i] >= 0)
+            {
+              const Tensor<1, dim> value =
+                prescribed_displacements[displacement_set[i]](disc.position[i], t + dt);
+              for (unsigned int d = 0; d < dim; ++d)
+                box_v[d * N + pos[i]] = (value[d] - box_u[d * N + pos[i]]) / dt;
+            }
+        for (const unsigned int i : velocity_nodes)
+          {
+            const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], t + 0.5 * dt);
+            for (unsigned int d = 0; d < dim; ++d)
+              box_v[d * N + pos[i]] = v[d];
+          }
+        // Half-kick and drift of the whole box (w = 0 off the free owned nodes).
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            double       *u = box_u.data() + d * N, *v = box_v.data() + d * N;
+            double       *p = box_p.data() + d * N;
+            const double *f = box_f.data() + d * N, *b = box_b.data() + d * N;
+            const double *x = box_x.data() + d * N;
+            if (s == 0) // f holds a^n
+              for (std::size_t L = 0; L < E; ++L)
+                {
+                  v[L] += 0.5 * dt * f[L];
+                  u[L] += dt * v[L];
+                  p[L] = x[L] + u[L];
+                }
+            else if (has_body)
+              for (std::size_t L = 0; L < E; ++L)
+                {
+                  const double a = w[L] * (f[L] + b[L]);
+                  v[L] += 0.5 * dt * a;
+                  u[L] += dt * v[L];
+                  p[L] = x[L] + u[L];
+                }
+            else
+              for (std::size_t L = 0; L < E; ++L)
+                {
+                  const double a = w[L] * f[L];
+                  v[L] += 0.5 * dt * a;
+                  u[L] += dt * v[L];
+                  p[L] = x[L] + u[L];
+                }
+          }
+        // Held nodes after it.
+        for (const unsigned int i : displacement_nodes)
+          if (displacement_set[i] >= 0)
+            {
+              const Tensor<1, dim> value =
+                prescribed_displacements[displacement_set[i]](disc.position[i], t + dt);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  box_u[d * N + pos[i]] = value[d];
+                  box_p[d * N + pos[i]] = box_x[d * N + pos[i]] + value[d];
+                }
+            }
+        for (const unsigned int i : velocity_nodes)
+          {
+            const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], t + dt);
+            for (unsigned int d = 0; d < dim; ++d)
+              box_v[d * N + pos[i]] = v[d];
+          }
+        if (body_force_function)
+          {
+            body_force_function(t + dt, body_force);
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int i = 0; i < n_owned; ++i)
+                box_b[d * N + pos[i]] = body_force[d].local_element(i);
+          }
+        // Ghost layer: the owned values other ranks import, through the
+        // node vectors.
+        if (parallel)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              Vector &ud = displacement[d];
+              for (const auto &[first, last] : ud.get_partitioner()->import_indices())
+                for (unsigned int i = first; i < last; ++i)
+                  ud.local_element(i) = box_u[d * N + pos[i]];
+              ud.update_ghost_values();
+              for (std::size_t g = n_owned; g < n_local; ++g)
+                {
+                  box_u[d * N + pos[g]] = ud.local_element(g);
+                  box_p[d * N + pos[g]] = box_x[d * N + pos[g]] + ud.local_element(g);
+                }
+            }
+        op.lattice_sweep_forces(box_p.data(), kick);
+        t += dt;
+        ++n_steps;
+      }
+
+    // Back to the node vectors (a as update_accelerations() sets it).
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        for (std::size_t i = 0; i < n_local; ++i)
+          displacement[d].local_element(i) = box_u[d * N + pos[i]];
+        for (unsigned int i = 0; i < n_owned; ++i)
+          {
+            const std::size_t L         = d * N + pos[i];
+            velocity[d].local_element(i) = box_v[L];
+            force[d].local_element(i)    = box_f[L];
+            acceleration[d].local_element(i) =
+              is_held(i) ? 0. : inv_rho * (box_f[L] + body_force[d].local_element(i));
+          }
+      }
   }
 
   template <int dim>
