@@ -1049,7 +1049,8 @@ namespace PeriDEAL
           }
         for (unsigned int d = 0; d < dim; ++d)
           {
-            double *ad = a + d * C, *Rd = R + d * N + c0;
+            double *__restrict ad = a + d * C, *__restrict Rd = R + d * N + c0;
+#pragma omp simd
             for (unsigned int k = 0; k < n; ++k)
               {
                 ad[k] -= Rd[k];

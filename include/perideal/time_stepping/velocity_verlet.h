@@ -285,11 +285,12 @@ namespace PeriDEAL
     BondBasedOperator<dim> *sweep_model = nullptr;
     /**
      * The box state of advance(n): per component (stride
-     * lattice_sweep_stride()) displacement, velocity, internal force, body
-     * force, deformed position and reference position x - x_c; per position
-     * 1/rho at free owned nodes, 0 elsewhere (held, ghost, empty).
+     * lattice_sweep_stride()) displacement, velocity, a^n then internal
+     * force, body force, deformed position and reference position x - x_c;
+     * per position 2 (free owned node), 1 (held owned node) or 0.
      */
-    std::vector<double> box_u, box_v, box_f, box_b, box_p, box_x, box_w;
+    std::vector<double>       box_u, box_v, box_f, box_b, box_p, box_x;
+    std::vector<std::uint8_t> box_kind;
     /** advance(n) in the box layout. */
     void
     advance_in_box(const unsigned int n);
