@@ -665,14 +665,18 @@ namespace PeriDEAL
      * the bottleneck of sqrt + div (doc/benchmarks.md); l - r by one
      * explicit fused multiply-subtract. Every loop (full list, half list,
      * ghost list, lattice sweep) calls this, so all of them see bitwise the
-     * same stretch of a bond and break it together.
+     * same stretch of a bond and break it together. @p s0r is s0 r (the
+     * sweep passes it precomputed per offset: the same product). The
+     * unbroken lanes come from a second comparison rather than alive & ~brk,
+     * which would round-trip the mask through a general register on the
+     * critical path.
      */
     inline __m512d
     pmb_bond_scale(__m512d        l2,
                    const __mmask8 alive,
                    const __m512d  rb,
                    const __m512d  kb,
-                   const __m512d  vs0,
+                   const __m512d  s0r,
                    __mmask8      &brk)
     {
       // Masked-off and broken lanes get l2 = 1 to keep inv finite.
@@ -682,9 +686,10 @@ namespace PeriDEAL
       for (unsigned int it = 0; it < 2; ++it)
         inv = _mm512_mul_pd(inv,
                             _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), _mm512_set1_pd(1.5)));
-      const __m512d dl = _mm512_fmsub_pd(l2, inv, rb);
-      brk = _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
-      return _mm512_maskz_mul_pd(alive & ~brk, _mm512_mul_pd(kb, dl), inv);
+      const __m512d  dl   = _mm512_fmsub_pd(l2, inv, rb);
+      const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_LE_OQ);
+      brk                 = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_GT_OQ);
+      return _mm512_maskz_mul_pd(keep, _mm512_mul_pd(kb, dl), inv);
     }
 
     /**
@@ -717,15 +722,31 @@ namespace PeriDEAL
                          const double        s0,
                          std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
     {
+      // Everything loop-invariant in locals (pointers per offset and
+      // component, s0 r per offset), so that nothing is reloaded per vector.
       std::uint8_t *bits[NO];
-      __m512d       vk[NO], vr[NO];
+      __m512d       vk[NO], vr[NO], vs0r[NO];
+      const double *pj[NO][dim];
+      double       *rj[NO][dim];
+      const double *pi_[dim];
+      double       *ai[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          pi_[d] = p + d * N + c0;
+          ai[d]  = a + d * C;
+        }
       for (int q = 0; q < NO; ++q)
         {
           bits[q] = live + hs[q] * n_bytes + c0 / 8;
           vk[q]   = _mm512_set1_pd(k[hs[q]]);
           vr[q]   = _mm512_set1_pd(r[hs[q]]);
+          vs0r[q] = _mm512_mul_pd(_mm512_set1_pd(s0), vr[q]);
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              pj[q][d] = pi_[d] + o[hs[q]];
+              rj[q][d] = reaction + d * N + c0 + o[hs[q]];
+            }
         }
-      const __m512d vs0 = _mm512_set1_pd(s0);
       for (unsigned int v = 0; v < n; v += 8)
         {
           __mmask8 alive[NO], any = 0;
@@ -733,12 +754,11 @@ namespace PeriDEAL
             any |= alive[q] = bits[q][v / 8];
           if (any == 0)
             continue;
-          const std::size_t L = c0 + v;
-          __m512d           pi[dim], acc[dim];
+          __m512d pi[dim], acc[dim];
           for (unsigned int d = 0; d < dim; ++d)
             {
-              pi[d]  = _mm512_loadu_pd(p + d * N + L);
-              acc[d] = _mm512_load_pd(a + d * C + v);
+              pi[d]  = _mm512_loadu_pd(pi_[d] + v);
+              acc[d] = _mm512_load_pd(ai[d] + v);
             }
           for (int q = 0; q < NO; ++q)
             {
@@ -746,28 +766,28 @@ namespace PeriDEAL
                 continue;
               __m512d y[dim];
               for (unsigned int d = 0; d < dim; ++d)
-                y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
+                y[d] = _mm512_sub_pd(_mm512_loadu_pd(pj[q][d] + v), pi[d]);
               __m512d l2 = _mm512_mul_pd(y[0], y[0]);
               for (unsigned int d = 1; d < dim; ++d)
                 l2 = _mm512_fmadd_pd(y[d], y[d], l2);
               __mmask8      brk;
-              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0, brk);
+              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0r[q], brk);
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  double *rd = reaction + d * N + L + o[hs[q]];
+                  double *rd = rj[q][d] + v;
                   acc[d]     = _mm512_fmadd_pd(scale, y[d], acc[d]);
                   _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
                 }
-              if (brk)
+              if (__builtin_expect(brk != 0, 0))
                 {
                   bits[q][v / 8] = alive[q] & ~brk;
                   for (unsigned int l = 0; l < 8; ++l)
                     if ((brk >> l) & 1u)
-                      broken.emplace_back(hs[q], std::uint32_t(L + l));
+                      broken.emplace_back(hs[q], std::uint32_t(c0 + v + l));
                 }
             }
           for (unsigned int d = 0; d < dim; ++d)
-            _mm512_store_pd(a + d * C + v, acc[d]);
+            _mm512_store_pd(ai[d] + v, acc[d]);
         }
     }
 
@@ -810,9 +830,10 @@ namespace PeriDEAL
           for (unsigned int d = 1; d < dim; ++d)
             l2 = _mm512_fmadd_pd(y[d], y[d], l2);
           __mmask8      brk;
+          const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
           const __m512d scale =
-            pmb_bond_scale(l2, alive, _mm512_maskz_loadu_pd(alive, r + b),
-                           _mm512_maskz_loadu_pd(alive, k + b), vs0, brk);
+            pmb_bond_scale(l2, alive, rb, _mm512_maskz_loadu_pd(alive, k + b),
+                           _mm512_mul_pd(vs0, rb), brk);
           if constexpr (Scatter)
             {
               __m512d t[dim];
