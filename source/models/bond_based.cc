@@ -665,14 +665,18 @@ namespace PeriDEAL
      * the bottleneck of sqrt + div (doc/benchmarks.md); l - r by one
      * explicit fused multiply-subtract. Every loop (full list, half list,
      * ghost list, lattice sweep) calls this, so all of them see bitwise the
-     * same stretch of a bond and break it together.
+     * same stretch of a bond and break it together. @p s0r is s0 r (the
+     * sweep passes it precomputed per offset: the same product). The
+     * unbroken lanes come from a second comparison rather than alive & ~brk,
+     * which would round-trip the mask through a general register on the
+     * critical path.
      */
     inline __m512d
     pmb_bond_scale(__m512d        l2,
                    const __mmask8 alive,
                    const __m512d  rb,
                    const __m512d  kb,
-                   const __m512d  vs0,
+                   const __m512d  s0r,
                    __mmask8      &brk)
     {
       // Masked-off and broken lanes get l2 = 1 to keep inv finite.
@@ -682,9 +686,10 @@ namespace PeriDEAL
       for (unsigned int it = 0; it < 2; ++it)
         inv = _mm512_mul_pd(inv,
                             _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), _mm512_set1_pd(1.5)));
-      const __m512d dl = _mm512_fmsub_pd(l2, inv, rb);
-      brk = _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
-      return _mm512_maskz_mul_pd(alive & ~brk, _mm512_mul_pd(kb, dl), inv);
+      const __m512d  dl   = _mm512_fmsub_pd(l2, inv, rb);
+      const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_LE_OQ);
+      brk                 = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_GT_OQ);
+      return _mm512_maskz_mul_pd(keep, _mm512_mul_pd(kb, dl), inv);
     }
 
     /**
@@ -717,15 +722,31 @@ namespace PeriDEAL
                          const double        s0,
                          std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
     {
+      // Everything loop-invariant in locals (pointers per offset and
+      // component, s0 r per offset), so that nothing is reloaded per vector.
       std::uint8_t *bits[NO];
-      __m512d       vk[NO], vr[NO];
+      __m512d       vk[NO], vr[NO], vs0r[NO];
+      const double *pj[NO][dim];
+      double       *rj[NO][dim];
+      const double *pi_[dim];
+      double       *ai[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          pi_[d] = p + d * N + c0;
+          ai[d]  = a + d * C;
+        }
       for (int q = 0; q < NO; ++q)
         {
           bits[q] = live + hs[q] * n_bytes + c0 / 8;
           vk[q]   = _mm512_set1_pd(k[hs[q]]);
           vr[q]   = _mm512_set1_pd(r[hs[q]]);
+          vs0r[q] = _mm512_mul_pd(_mm512_set1_pd(s0), vr[q]);
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              pj[q][d] = pi_[d] + o[hs[q]];
+              rj[q][d] = reaction + d * N + c0 + o[hs[q]];
+            }
         }
-      const __m512d vs0 = _mm512_set1_pd(s0);
       for (unsigned int v = 0; v < n; v += 8)
         {
           __mmask8 alive[NO], any = 0;
@@ -733,12 +754,11 @@ namespace PeriDEAL
             any |= alive[q] = bits[q][v / 8];
           if (any == 0)
             continue;
-          const std::size_t L = c0 + v;
-          __m512d           pi[dim], acc[dim];
+          __m512d pi[dim], acc[dim];
           for (unsigned int d = 0; d < dim; ++d)
             {
-              pi[d]  = _mm512_loadu_pd(p + d * N + L);
-              acc[d] = _mm512_load_pd(a + d * C + v);
+              pi[d]  = _mm512_loadu_pd(pi_[d] + v);
+              acc[d] = _mm512_load_pd(ai[d] + v);
             }
           for (int q = 0; q < NO; ++q)
             {
@@ -746,28 +766,28 @@ namespace PeriDEAL
                 continue;
               __m512d y[dim];
               for (unsigned int d = 0; d < dim; ++d)
-                y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
+                y[d] = _mm512_sub_pd(_mm512_loadu_pd(pj[q][d] + v), pi[d]);
               __m512d l2 = _mm512_mul_pd(y[0], y[0]);
               for (unsigned int d = 1; d < dim; ++d)
                 l2 = _mm512_fmadd_pd(y[d], y[d], l2);
               __mmask8      brk;
-              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0, brk);
+              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0r[q], brk);
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  double *rd = reaction + d * N + L + o[hs[q]];
+                  double *rd = rj[q][d] + v;
                   acc[d]     = _mm512_fmadd_pd(scale, y[d], acc[d]);
                   _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
                 }
-              if (brk)
+              if (__builtin_expect(brk != 0, 0))
                 {
                   bits[q][v / 8] = alive[q] & ~brk;
                   for (unsigned int l = 0; l < 8; ++l)
                     if ((brk >> l) & 1u)
-                      broken.emplace_back(hs[q], std::uint32_t(L + l));
+                      broken.emplace_back(hs[q], std::uint32_t(c0 + v + l));
                 }
             }
           for (unsigned int d = 0; d < dim; ++d)
-            _mm512_store_pd(a + d * C + v, acc[d]);
+            _mm512_store_pd(ai[d] + v, acc[d]);
         }
     }
 
@@ -810,9 +830,10 @@ namespace PeriDEAL
           for (unsigned int d = 1; d < dim; ++d)
             l2 = _mm512_fmadd_pd(y[d], y[d], l2);
           __mmask8      brk;
+          const __m512d rb = _mm512_maskz_loadu_pd(alive, r + b);
           const __m512d scale =
-            pmb_bond_scale(l2, alive, _mm512_maskz_loadu_pd(alive, r + b),
-                           _mm512_maskz_loadu_pd(alive, k + b), vs0, brk);
+            pmb_bond_scale(l2, alive, rb, _mm512_maskz_loadu_pd(alive, k + b),
+                           _mm512_mul_pd(vs0, rb), brk);
           if constexpr (Scatter)
             {
               __m512d t[dim];
@@ -964,21 +985,25 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  Point<dim>
+  BondBasedOperator<dim>::deformation_origin() const
+  {
+    std::array<int, dim> mid;
+    for (unsigned int d = 0; d < dim; ++d)
+      mid[d] = int(disc.lattice_size()[d] / 2);
+    return disc.lattice_point(mid);
+  }
+
+  template <int dim>
   void
   BondBasedOperator<dim>::sweep_forces(const VectorField &u, VectorField &force)
   {
-#ifdef PERIDEAL_PMB_AVX512
-    if (!sweep_bits_valid)
-      build_sweep_bits();
     const std::vector<Point<dim>> &x       = disc.position;
     const unsigned int             n_owned = disc.n_owned();
     const std::size_t              N       = sweep_n_alloc;
     // Deformed positions x - x_c + u as in the list loops (bitwise the same
     // values), one array per component over the box.
-    std::array<int, dim> mid;
-    for (unsigned int d = 0; d < dim; ++d)
-      mid[d] = int(disc.lattice_size()[d] / 2);
-    const Point<dim> xc = disc.lattice_point(mid);
+    const Point<dim> xc = deformation_origin();
     for (unsigned int d = 0; d < dim; ++d)
       {
         double       *pd = sweep_p.data() + d * N;
@@ -986,24 +1011,45 @@ namespace PeriDEAL
         for (std::size_t i = 0; i < x.size(); ++i)
           pd[sweep_position[i]] = (x[i][d] - xc[d]) + ud[i];
       }
+    lattice_sweep_forces(sweep_p.data(), [&](const std::size_t  c0,
+                                             const unsigned int   n,
+                                             const double        *f,
+                                             const unsigned int   C) {
+      const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
+      for (std::size_t L = c0; L < c1; ++L)
+        {
+          const std::int32_t i = sweep_node[L];
+          if (i >= 0 && i < std::int32_t(n_owned))
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(i) = f[d * C + L - c0];
+        }
+    });
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::lattice_sweep_forces(const double *p, const SweepChunkFinish &finish)
+  {
+#ifdef PERIDEAL_PMB_AVX512
+    AssertThrow(uses_lattice_sweep(), ExcMessage("The lattice sweep is not in use."));
+    if (!sweep_bits_valid)
+      build_sweep_bits();
+    const unsigned int n_owned = disc.n_owned();
+    const std::size_t  N       = sweep_n_alloc;
     sweep_broken.clear();
     // Chunks of C box positions, all offsets per chunk: the chunk's
     // positions, forces and the reactions it reaches (up to the largest
     // offset beyond it) stay in L2. A position's force is final once its
-    // chunk is done (reactions come from lower positions only).
+    // chunk is done (reactions come from lower positions only). The
+    // reaction array is zero between calls: each chunk clears what it
+    // consumed (no separate memset pass).
     constexpr unsigned int C = 512;
     alignas(64) double     a[dim * C];
-    const std::int64_t     o_max  = sweep_offset.back();
     const std::size_t      n_bits = 8 * sweep_n_bytes;
     double                *R      = sweep_reaction.data();
-    std::size_t            zeroed = 0;
     for (std::size_t c0 = 0; c0 < n_bits; c0 += C)
       {
-        const unsigned int n    = std::min<std::size_t>(C, n_bits - c0);
-        const std::size_t  need = std::min<std::size_t>(N, c0 + n + o_max + 8);
-        for (unsigned int d = 0; d < dim; ++d)
-          std::fill(R + d * N + zeroed, R + d * N + need, 0.);
-        zeroed = std::max(zeroed, need);
+        const unsigned int n = std::min<std::size_t>(C, n_bits - c0);
         std::fill(a, a + dim * C, 0.);
         // Two offsets per pass (shared p_L loads and force updates): h and
         // h + n_pairs, which lie in different lattice lines.
@@ -1011,26 +1057,32 @@ namespace PeriDEAL
         for (unsigned int h = 0; h < n_pairs; ++h)
           {
             const unsigned int hs[2] = {h, h + n_pairs};
-            sweep_offsets_avx512<dim, 2>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
-                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
-                                         sweep_r.data(), s0, sweep_broken);
+            sweep_offsets_avx512<dim, 2>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
+                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
+                                         s0, sweep_broken);
           }
         if (n_half % 2)
           {
             const unsigned int hs[1] = {n_half - 1};
-            sweep_offsets_avx512<dim, 1>(sweep_p.data(), R, a, sweep_live.data(), sweep_n_bytes,
-                                         N, C, c0, n, sweep_offset.data(), hs, sweep_k.data(),
-                                         sweep_r.data(), s0, sweep_broken);
+            sweep_offsets_avx512<dim, 1>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
+                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
+                                         s0, sweep_broken);
           }
-        const std::size_t c1 = std::min<std::size_t>(c0 + n, sweep_n_box);
-        for (std::size_t L = c0; L < c1; ++L)
+        for (unsigned int d = 0; d < dim; ++d)
           {
-            const std::int32_t i = sweep_node[L];
-            if (i >= 0 && i < std::int32_t(n_owned))
-              for (unsigned int d = 0; d < dim; ++d)
-                force[d].local_element(i) = a[d * C + L - c0] - R[d * N + L];
+            double *__restrict ad = a + d * C, *__restrict Rd = R + d * N + c0;
+#pragma omp simd
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                ad[k] -= Rd[k];
+                Rd[k] = 0.;
+              }
           }
+        finish(c0, n, a, C);
       }
+    // Reactions that landed beyond the last chunk (on no node).
+    for (unsigned int d = 0; d < dim; ++d)
+      std::fill(R + d * N + n_bits, R + (d + 1) * N, 0.);
     // Flag the CSR copies of the newly broken bonds (rare).
     const unsigned int centre = centre_index();
     for (const auto &[h, L] : sweep_broken)
@@ -1042,9 +1094,9 @@ namespace PeriDEAL
           broken_flag[find_bond(upper, 2 * centre - sweep_box_index[h])] = 1;
       }
 #else
-    (void)u;
-    (void)force;
-    Assert(false, ExcInternalError());
+    (void)p;
+    (void)finish;
+    AssertThrow(false, ExcMessage("The lattice sweep is not compiled."));
 #endif
   }
 
@@ -1071,10 +1123,7 @@ namespace PeriDEAL
         const std::size_t  n_local = x.size();
         constexpr unsigned int R   = node_stride<dim>;
         deformed.assign(n_local * R, 0.);
-        std::array<int, dim> mid;
-        for (unsigned int d = 0; d < dim; ++d)
-          mid[d] = int(disc.lattice_size()[d] / 2);
-        const Point<dim> xc = disc.lattice_point(mid);
+        const Point<dim> xc = deformation_origin();
         for (unsigned int d = 0; d < dim; ++d)
           {
             const double *ud = u[d].begin();

@@ -104,6 +104,13 @@ namespace PeriDEAL
         return s.str();
       }
 
+      /** The wrapped operator. */
+      Operator &
+      wrapped() const
+      {
+        return op;
+      }
+
     private:
       Operator &op;
     };
@@ -132,6 +139,7 @@ namespace PeriDEAL
     , disc(op.discretization())
     , rho(density)
     , dt(time_step)
+    , sweep_model(&op)
   {
     setup();
   }
@@ -145,6 +153,8 @@ namespace PeriDEAL
     , rho(density)
     , dt(time_step)
   {
+    if (auto *a = dynamic_cast<Adapter<dim, BondBasedOperator<dim>> *>(&model))
+      sweep_model = &a->wrapped();
     setup();
   }
 
@@ -341,6 +351,235 @@ namespace PeriDEAL
     // Prescribed nodes have a = 0, so their velocity stays as set.
     t += dt;
     ++n_steps;
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::advance(const unsigned int n)
+  {
+    if (n > 1 && uses_box_state())
+      advance_in_box(n);
+    else
+      for (unsigned int s = 0; s < n; ++s)
+        advance();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::advance_in_box(const unsigned int n_now)
+  {
+    BondBasedOperator<dim>           &op      = *sweep_model;
+    const std::size_t                 N       = op.lattice_sweep_stride();
+    const std::size_t                 E       = op.lattice_sweep_extent();
+    const std::vector<std::uint32_t> &pos     = op.lattice_sweep_positions();
+    const unsigned int                n_owned = disc.n_owned();
+    const std::size_t                 n_local = disc.position.size();
+    const double                      inv_rho = 1. / rho;
+    const bool parallel = Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1;
+
+    // Load the node vectors into the box. Positions without a local node
+    // stay zero in every array (no pass writes anything else there).
+    if (box_u.size() != dim * N)
+      {
+        for (std::vector<double> *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
+          b->assign(dim * N, 0.);
+        const Point<dim> xc = op.deformation_origin();
+        for (unsigned int d = 0; d < dim; ++d)
+          for (std::size_t i = 0; i < n_local; ++i)
+            box_x[d * N + pos[i]] = disc.position[i][d] - xc[d];
+      }
+    box_kind.assign(N, 0);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      box_kind[pos[i]] = is_held(i) ? 1 : 2;
+    bool has_body = bool(body_force_function);
+    for (unsigned int d = 0; d < dim; ++d)
+      for (unsigned int i = 0; i < n_owned; ++i)
+        has_body = has_body || body_force[d].local_element(i) != 0.;
+    std::vector<unsigned int> velocity_nodes;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (prescribed_set[i] >= 0)
+        velocity_nodes.push_back(i);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double *u = box_u.data() + d * N, *p = box_p.data() + d * N;
+        const double *x = box_x.data() + d * N;
+        for (std::size_t i = 0; i < n_local; ++i)
+          {
+            u[pos[i]] = displacement[d].local_element(i);
+            p[pos[i]] = x[pos[i]] + u[pos[i]];
+          }
+        // box_f holds a^n for the first half-kick, F after the last step.
+        double *v = box_v.data() + d * N, *f = box_f.data() + d * N, *b = box_b.data() + d * N;
+        for (std::size_t i = n_owned; i < n_local; ++i)
+          v[pos[i]] = f[pos[i]] = b[pos[i]] = 0.;
+        for (unsigned int i = 0; i < n_owned; ++i)
+          {
+            v[pos[i]] = velocity[d].local_element(i);
+            f[pos[i]] = acceleration[d].local_element(i);
+            b[pos[i]] = body_force[d].local_element(i);
+          }
+      }
+
+    // Held nodes before (at time t of the step) and after the drift, as
+    // in advance().
+    const auto held_before_drift = [&](const double time) {
+      for (const unsigned int i : displacement_nodes)
+        if (displacement_set[i] >= 0)
+          {
+            const Tensor<1, dim> value =
+              prescribed_displacements[displacement_set[i]](disc.position[i], time + dt);
+            for (unsigned int d = 0; d < dim; ++d)
+              box_v[d * N + pos[i]] = (value[d] - box_u[d * N + pos[i]]) / dt;
+          }
+      for (const unsigned int i : velocity_nodes)
+        {
+          const Tensor<1, dim> v =
+            prescribed_values[prescribed_set[i]](disc.position[i], time + 0.5 * dt);
+          for (unsigned int d = 0; d < dim; ++d)
+            box_v[d * N + pos[i]] = v[d];
+        }
+    };
+    const auto held_after_drift = [&](const double time) {
+      for (const unsigned int i : displacement_nodes)
+        if (displacement_set[i] >= 0)
+          {
+            const Tensor<1, dim> value =
+              prescribed_displacements[displacement_set[i]](disc.position[i], time + dt);
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                box_u[d * N + pos[i]] = value[d];
+                box_p[d * N + pos[i]] = box_x[d * N + pos[i]] + value[d];
+              }
+          }
+      for (const unsigned int i : velocity_nodes)
+        {
+          const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time + dt);
+          for (unsigned int d = 0; d < dim; ++d)
+            box_v[d * N + pos[i]] = v[d];
+        }
+    };
+
+    // The first half-kick and drift with the stored a^n (zero at held and
+    // non-owned positions).
+    held_before_drift(t);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+        double *__restrict p       = box_p.data() + d * N;
+        const double *__restrict f = box_f.data() + d * N, *__restrict x = box_x.data() + d * N;
+        const double h = 0.5 * dt, tau = dt;
+#pragma omp simd
+        for (std::size_t L = 0; L < E; ++L)
+          {
+            v[L] += h * f[L];
+            u[L] += tau * v[L];
+            p[L] = x[L] + u[L];
+          }
+      }
+
+    // Per chunk of final forces of step s: the second half-kick with
+    // a = (F + b) / rho (0 at held nodes), then, unless s is the last step,
+    // the first half-kick and the drift of step s + 1. Both are final for
+    // the chunk: the sweep never reads a position below its current chunk
+    // again. After the last step box_f holds F.
+    const std::uint8_t *kind = box_kind.data();
+    bool                last = false;
+    const auto          kick = [&](const std::size_t c0, const unsigned int n, const double *fc,
+                          const unsigned int C) {
+      const std::uint8_t *__restrict k8 = kind + c0;
+      // Locals, not captures: the vectorizer must see loop invariants.
+      const double h = 0.5 * dt, tau = dt, ir = inv_rho;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          double *__restrict u       = box_u.data() + d * N + c0;
+          double *__restrict v       = box_v.data() + d * N + c0;
+          double *__restrict p       = box_p.data() + d * N + c0;
+          double *__restrict f       = box_f.data() + d * N + c0;
+          const double *__restrict b = box_b.data() + d * N + c0;
+          const double *__restrict x = box_x.data() + d * N + c0;
+          const double *__restrict F = fc + d * C;
+          if (last)
+#pragma omp simd
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                const double a = k8[k] == 2 ? ir * (F[k] + b[k]) : 0.;
+                v[k] += h * a;
+                f[k] = k8[k] != 0 ? F[k] : 0.;
+              }
+          else if (has_body)
+#pragma omp simd
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                const double a = k8[k] == 2 ? ir * (F[k] + b[k]) : 0.;
+                v[k] += h * a;
+                v[k] += h * a;
+                u[k] += tau * v[k];
+                p[k] = x[k] + u[k];
+              }
+          else
+#pragma omp simd
+            for (unsigned int k = 0; k < n; ++k)
+              {
+                const double a = k8[k] == 2 ? ir * F[k] : 0.;
+                v[k] += h * a;
+                v[k] += h * a;
+                u[k] += tau * v[k];
+                p[k] = x[k] + u[k];
+              }
+        }
+    };
+
+    for (unsigned int s = 0; s < n_now; ++s)
+      {
+        const double t1 = t + dt;
+        held_after_drift(t);
+        if (body_force_function)
+          {
+            body_force_function(t1, body_force);
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int i = 0; i < n_owned; ++i)
+                box_b[d * N + pos[i]] = body_force[d].local_element(i);
+          }
+        last = s + 1 == n_now;
+        // The next step's held velocities (held nodes have a = 0, so the
+        // kicks of this step leave them).
+        if (!last)
+          held_before_drift(t1);
+        // Ghost layer: the owned values other ranks import, through the
+        // node vectors.
+        if (parallel)
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              Vector &ud = displacement[d];
+              for (const auto &[first, end] : ud.get_partitioner()->import_indices())
+                for (unsigned int i = first; i < end; ++i)
+                  ud.local_element(i) = box_u[d * N + pos[i]];
+              ud.update_ghost_values();
+              for (std::size_t g = n_owned; g < n_local; ++g)
+                {
+                  box_u[d * N + pos[g]] = ud.local_element(g);
+                  box_p[d * N + pos[g]] = box_x[d * N + pos[g]] + ud.local_element(g);
+                }
+            }
+        op.lattice_sweep_forces(box_p.data(), kick);
+        t = t1;
+        ++n_steps;
+      }
+
+    // Back to the node vectors (a as update_accelerations() sets it).
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        for (std::size_t i = 0; i < n_local; ++i)
+          displacement[d].local_element(i) = box_u[d * N + pos[i]];
+        for (unsigned int i = 0; i < n_owned; ++i)
+          {
+            const std::size_t L         = d * N + pos[i];
+            velocity[d].local_element(i) = box_v[L];
+            force[d].local_element(i)    = box_f[L];
+            acceleration[d].local_element(i) =
+              is_held(i) ? 0. : inv_rho * (box_f[L] + body_force[d].local_element(i));
+          }
+      }
   }
 
   template <int dim>

@@ -722,6 +722,101 @@ namespace
     half_list_dim<2>(Loop::lattice_sweep);
     half_list_dim<3>(Loop::lattice_sweep);
   }
+
+  // VelocityVerlet::advance(n) keeps the state in the lattice sweep's box
+  // layout: after every call it must equal, bitwise, the same number of
+  // advance() steps (the node-ordered path), with every feature the step
+  // touches: pre-cut and newly breaking bonds, a prescribed velocity v(x, t)
+  // on one strip, a prescribed displacement u(x, t) on another (which also
+  // gives nonzero reaction forces through internal_force()), and a
+  // time-dependent body force; on 1 and 2 ranks (ghost exchange).
+  template <int dim>
+  void
+  box_state_dim()
+  {
+    const double side = dim == 3 ? 1. : 2.;
+    const auto   disc = make_box<dim>(MPI_COMM_WORLD, side, 0.1, 0.3015);
+    BondBasedModelParameters p;
+    p.critical_stretch = 0.01;
+    BondBasedOperator<dim> op_a(*disc, p), op_b(*disc, p);
+    const auto cuts = [](const Point<dim> &a, const Point<dim> &b) {
+      return a[0] < 0.75 && b[0] < 0.75 && (a[1] - 0.55) * (b[1] - 0.55) < 0.;
+    };
+    op_a.break_bonds(cuts);
+    op_b.break_bonds(cuts);
+    const double        rho = 1.;
+    const double        dt  = 0.8 * op_a.critical_time_step(rho);
+    VelocityVerlet<dim> a(op_a, rho, dt), b(op_b, rho, dt);
+    const std::string   tag = std::to_string(dim) + "D, " +
+                            std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) + " ranks: ";
+    if (BondBasedOperator<dim>::lattice_sweep_compiled())
+      check(b.uses_box_state(), tag + "advance(n) keeps the state in the box layout");
+    std::vector<bool> top(disc->n_owned()), bottom(disc->n_owned());
+    for (unsigned int i = 0; i < disc->n_owned(); ++i)
+      {
+        top[i]    = disc->position[i][1] > side - 0.25;
+        bottom[i] = disc->position[i][1] < 0.15;
+      }
+    const auto pull = [](const Point<dim> &x, const double t) {
+      Tensor<1, dim> v;
+      v[1] = 0.005 + 0.001 * x[0] + 0.01 * t;
+      return v;
+    };
+    const auto hold = [](const Point<dim> &x, const double t) {
+      Tensor<1, dim> u;
+      u[0] = 0.001 * t * x[0];
+      u[1] = -0.002 * t * t;
+      return u;
+    };
+    const auto body = [&](const double t, typename VelocityVerlet<dim>::VectorField &f) {
+      for (unsigned int i = 0; i < disc->n_owned(); ++i)
+        f[dim - 1].local_element(i) = 0.01 * std::sin(disc->position[i][0] + 10. * t);
+    };
+    for (VelocityVerlet<dim> *v : {&a, &b})
+      {
+        for (unsigned int i = 0; i < disc->n_owned(); ++i)
+          for (unsigned int d = 0; d < dim; ++d)
+            v->velocity[d].local_element(i) = 2e-4 * hash_random(disc->id[i], d);
+        v->add_prescribed_velocity(top, pull);
+        v->add_prescribed_displacement(bottom, hold);
+        v->set_body_force_function(body);
+        v->initialize();
+      }
+    const std::uint64_t pre = op_a.n_broken_bonds();
+    unsigned int        differ = 0;
+    for (const unsigned int n : {3u, 1u, 7u, 13u, 16u})
+      {
+        for (unsigned int s = 0; s < n; ++s)
+          a.advance();
+        b.advance(n);
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            for (unsigned int i = 0; i < disc->n_owned() + disc->n_ghost(); ++i)
+              differ += a.displacement[d].local_element(i) != b.displacement[d].local_element(i);
+            for (unsigned int i = 0; i < disc->n_owned(); ++i)
+              differ += a.velocity[d].local_element(i) != b.velocity[d].local_element(i) ||
+                        a.acceleration[d].local_element(i) != b.acceleration[d].local_element(i) ||
+                        a.internal_force()[d].local_element(i) != b.internal_force()[d].local_element(i);
+          }
+        for (std::size_t k = 0; k < op_a.broken().size(); ++k)
+          differ += op_a.broken()[k] != op_b.broken()[k];
+        differ += a.step() != b.step() || a.time() != b.time();
+      }
+    differ = Utilities::MPI::sum(differ, MPI_COMM_WORLD);
+    check(differ == 0, tag + std::to_string(differ) +
+                         " values (u, v, a, F, broken flags, step, time) differ from advance()");
+    const std::uint64_t broke = op_b.n_broken_bonds() - pre;
+    check(pre > 0 && broke > 0, tag + std::to_string(pre) + " pre-cut, " + std::to_string(broke) +
+                                  " newly broken bond copies");
+    check(a.kinetic_energy() == b.kinetic_energy(), tag + "kinetic energy " + sci(b.kinetic_energy()));
+  }
+
+  void
+  box_state()
+  {
+    box_state_dim<2>();
+    box_state_dim<3>();
+  }
 } // namespace
 
 int
@@ -737,5 +832,6 @@ main(int argc, char **argv)
               {"rank_invariance", rank_invariance},
               {"force_kernel", force_kernel},
               {"half_list", half_list},
-              {"lattice_sweep", lattice_sweep}});
+              {"lattice_sweep", lattice_sweep},
+              {"box_state", box_state}});
 }

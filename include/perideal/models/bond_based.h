@@ -8,6 +8,7 @@
 #include <perideal/discretization/discretization.h>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -238,6 +239,53 @@ namespace PeriDEAL
     {
       return sweep && sweep_available;
     }
+
+    /**
+     * @name The lattice sweep's box layout, for integrators that keep their
+     * state in it (VelocityVerlet::advance(n)). Valid if uses_lattice_sweep().
+     */
+    /** @{ */
+    /**
+     * Called per chunk of box positions [first, first + n) once their forces
+     * are final: component d of position first + k is f[d * stride + k]
+     * (meaningless where no owned node sits).
+     */
+    using SweepChunkFinish = std::function<
+      void(const std::size_t first, const unsigned int n, const double *f, const unsigned int stride)>;
+
+    /** Stride of the per-component box arrays (positions plus padding). */
+    std::size_t
+    lattice_sweep_stride() const
+    {
+      return sweep_n_alloc;
+    }
+    /** Box positions the sweep visits: [0, extent), extent a multiple of 8, <= stride. */
+    std::size_t
+    lattice_sweep_extent() const
+    {
+      return 8 * sweep_n_bytes;
+    }
+    /** Box position of every local (owned and ghost) node. */
+    const std::vector<std::uint32_t> &
+    lattice_sweep_positions() const
+    {
+      return sweep_position;
+    }
+    /**
+     * x_c of the deformed positions p = (x - x_c) + u that the force loops
+     * use (the lattice centre, the same on every rank).
+     */
+    Point<dim>
+    deformation_origin() const;
+    /**
+     * The lattice-sweep force for deformed positions @p p (dim arrays of
+     * lattice_sweep_stride() doubles, box order, ghosts up to date),
+     * handing each chunk's forces to @p finish; breaks bonds like
+     * compute_forces(), bitwise the same arithmetic.
+     */
+    void
+    lattice_sweep_forces(const double *p, const SweepChunkFinish &finish);
+    /** @} */
 
     /**
      * W_i = 1/2 sum_j mu 1/2 c omega s^2 |xi| beta V_j (2.26)-(2.27): each

@@ -193,6 +193,28 @@ namespace PeriDEAL
     void
     advance();
 
+    /**
+     * @p n Verlet steps: the same as n calls of advance() (bitwise the same
+     * state). With a bond-based model on the lattice sweep
+     * (BondBasedOperator::uses_lattice_sweep()) and n > 1, the state stays
+     * in the sweep's box layout during the n steps: the half-kick and drift
+     * run as one pass over the box, the second half-kick is fused with the
+     * sweep's per-chunk force output, and only the ghost layer is exchanged
+     * through the node vectors. displacement, velocity, acceleration and
+     * internal_force() are node-ordered again when the call returns, so
+     * output, energies, reaction forces and checkpoints between calls are
+     * unaffected.
+     */
+    void
+    advance(const unsigned int n);
+
+    /** True if advance(n) with n > 1 keeps the state in the sweep's box layout. */
+    bool
+    uses_box_state() const
+    {
+      return sweep_model != nullptr && sweep_model->uses_lattice_sweep();
+    }
+
     /** The critical time step (3.8) of the model for this density. */
     double
     critical_time_step() const
@@ -258,6 +280,20 @@ namespace PeriDEAL
     std::vector<unsigned int> displacement_nodes;
     void
     apply_prescribed_displacements(const double time, const bool set_velocity);
+
+    /** The bond-based operator behind model (nullptr for other models). */
+    BondBasedOperator<dim> *sweep_model = nullptr;
+    /**
+     * The box state of advance(n): per component (stride
+     * lattice_sweep_stride()) displacement, velocity, a^n then internal
+     * force, body force, deformed position and reference position x - x_c;
+     * per position 2 (free owned node), 1 (held owned node) or 0.
+     */
+    std::vector<double>       box_u, box_v, box_f, box_b, box_p, box_x;
+    std::vector<std::uint8_t> box_kind;
+    /** advance(n) in the box layout. */
+    void
+    advance_in_box(const unsigned int n);
   };
 } // namespace PeriDEAL
 
