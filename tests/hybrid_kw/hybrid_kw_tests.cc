@@ -8,7 +8,8 @@
 //             standard scheme (damage, crack length and angle; Omega_s grows
 //             only near the crack);
 //  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage;
-//  bad_input: ParameterError for bad Hybrid entries.
+//  bad_input: ParameterError for bad Hybrid entries;
+//  stretch_budget: the bound of StretchBudget (stretch_budget_test.h).
 
 #include <deal.II/base/mpi.h>
 
@@ -19,6 +20,7 @@
 
 #include "../check.h"
 #include "kalthoff_winkler_case.h"
+#include "stretch_budget_test.h"
 
 #include <map>
 
@@ -354,5 +356,6 @@ main(int argc, char **argv)
              {{"patch", patch},
               {"kw", kw},
               {"rank_invariance", rank_invariance},
-              {"bad_input", bad_input}});
+              {"bad_input", bad_input},
+              {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }
