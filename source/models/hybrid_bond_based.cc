@@ -74,32 +74,31 @@ namespace PeriDEAL
     }
 
     /**
-     * Switching test of one Omega_w row i, portable: the number of unbroken
-     * bonds b with |y|^2 >= L2[b] that this row tests: those to Omega_s
-     * nodes and to ghosts, and those to owned Omega_w nodes j > i (a bond
-     * between two owned Omega_w nodes is tested once). @p wf: 1 for Omega_w
-     * per local node.
+     * Exact switching test of one Omega_w row, portable: the number of
+     * unbroken bonds b with |y|^2 >= L2[b], and in @p q the maximum of
+     * |y|^2 / L2[b] = |y|^2 * iL2[b] over them (0 without unbroken bonds).
      */
     template <int dim>
     unsigned int
-    count_critical(const double       *p,
-                   const double       *pi,
-                   const std::int32_t *col,
-                   const double       *L2,
-                   const std::uint8_t *br,
-                   const unsigned int  n,
-                   const std::int32_t  i,
-                   const std::int32_t  n_owned,
-                   const std::int32_t *wf)
+    test_row(const double       *p,
+             const double       *pi,
+             const std::int32_t *col,
+             const double       *L2,
+             const double       *iL2,
+             const std::uint8_t *br,
+             const unsigned int  n,
+             double             &q)
     {
       unsigned int count = 0;
+      double       qmax  = 0.;
       for (unsigned int b = 0; b < n; ++b)
-        {
-          const std::int32_t j = col[b];
-          if ((j > i || j >= n_owned || wf[j] == 0) && br[b] == 0 &&
-              length2<dim>(p + std::size_t(dim) * j, pi) >= L2[b])
-            ++count;
-        }
+        if (br[b] == 0)
+          {
+            const double l2 = length2<dim>(p + std::size_t(dim) * col[b], pi);
+            count += l2 >= L2[b];
+            qmax = std::max(qmax, l2 * iL2[b]);
+          }
+      q = qmax;
       return count;
     }
 
@@ -162,38 +161,35 @@ namespace PeriDEAL
       return n_break;
     }
 
-    /** count_critical<2> with AVX-512. */
+    /** test_row<2> with AVX-512: the same expressions, eight bonds at a time. */
     unsigned int
-    count_critical_avx512(const double       *p,
-                          const double       *pi,
-                          const std::int32_t *col,
-                          const double       *L2,
-                          const std::uint8_t *br,
-                          const unsigned int  n,
-                          const std::int32_t  i,
-                          const std::int32_t  n_owned,
-                          const std::int32_t *wf)
+    test_row_avx512(const double       *p,
+                    const double       *pi,
+                    const std::int32_t *col,
+                    const double       *L2,
+                    const double       *iL2,
+                    const std::uint8_t *br,
+                    const unsigned int  n,
+                    double             &q)
     {
-      unsigned int  count = 0;
-      const __m256i vi = _mm256_set1_epi32(i), vo = _mm256_set1_epi32(n_owned - 1);
-      const __m256i zero = _mm256_setzero_si256();
+      unsigned int count = 0;
+      __m512d      qmax  = _mm512_setzero_pd();
       for (unsigned int b = 0; b < n; b += 8)
         {
-          const __mmask8 m  = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
-          const __m256i  cj = _mm256_maskz_loadu_epi32(m, col + b);
-          const __m256i  wj = _mm256_mmask_i32gather_epi32(zero, m, cj, wf, 4);
-          const __mmask8 tested =
-            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128()) &
-            (_mm256_cmpgt_epi32_mask(cj, vi) | _mm256_cmpgt_epi32_mask(cj, vo) |
-             _mm256_cmpeq_epi32_mask(wj, zero));
-          if (tested == 0)
+          const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
+          const __mmask8 alive =
+            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128());
+          if (alive == 0)
             continue;
           __m512d y0, y1;
-          gather_y2(p, pi, col, b, tested, y0, y1);
+          gather_y2(p, pi, col, b, alive, y0, y1);
           const __m512d l2 = _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0));
           count += __builtin_popcount(
-            _mm512_mask_cmp_pd_mask(tested, l2, _mm512_maskz_loadu_pd(tested, L2 + b), _CMP_GE_OQ));
+            _mm512_mask_cmp_pd_mask(alive, l2, _mm512_maskz_loadu_pd(alive, L2 + b), _CMP_GE_OQ));
+          qmax = _mm512_mask_max_pd(qmax, alive, qmax,
+                                    _mm512_mul_pd(l2, _mm512_maskz_loadu_pd(alive, iL2 + b)));
         }
+      q = _mm512_reduce_max_pd(qmax);
       return count;
     }
 #endif
@@ -243,6 +239,8 @@ namespace PeriDEAL
     const auto &nb = disc.neighborhood;
     critical_length2.resize(nb.bond_length.size());
     breaking_length2.resize(nb.bond_length.size());
+    inverse_critical_length2.resize(nb.bond_length.size());
+    double r_min = std::numeric_limits<double>::max(), r_max = 0.;
     const double s0_finite = std::isfinite(s0) ? s0 : std::numeric_limits<double>::max() / 4.;
     for (std::size_t t = 0; t < nb.bond_length.size(); ++t)
       {
@@ -251,7 +249,22 @@ namespace PeriDEAL
                                                   std::numeric_limits<double>::infinity();
         breaking_length2[t] = std::isfinite(s0) ? std::pow(r * (1. + s0_finite), 2) :
                                                   std::numeric_limits<double>::infinity();
+        inverse_critical_length2[t] = 1. / critical_length2[t];
+        r_min = std::min(r_min, r);
+        r_max = std::max(r_max, r);
       }
+    // The amortized test (see the class documentation): the slack of a node
+    // is (1 - sqrt(q)) min_b T_b minus a round-off margin: positions
+    // x - x_c + u carry errors ~1e-16 of the lattice extent, squared
+    // lengths and their ratios ~1e-16 relative; 1e-9 T_min + 1e-13 extent
+    // exceeds both by orders of magnitude and costs nothing measurable.
+    double extent = 0.;
+    for (unsigned int d = 0; d < dim; ++d)
+      extent = std::max(extent, disc.lattice_size()[d] * disc.parameters().dx);
+    min_threshold    = r_min * (1. + (std::isfinite(s0) ? prm.sigma * s0 : 0.));
+    threshold_margin = 1e-9 * min_threshold + 1e-13 * extent;
+    budget.reinit(disc.position, disc.n_owned(), r_max);
+    switched_at.assign(disc.n_owned(), -1);
     update_row_lists();
   }
 
@@ -259,7 +272,6 @@ namespace PeriDEAL
   void
   HybridBondBasedModel<dim>::update_row_lists()
   {
-    const auto &nb = disc.neighborhood;
     wls_mask.resize(disc.position.size());
     for (std::size_t k = 0; k < wls_mask.size(); ++k)
       wls_mask[k] = wls_flag.local_element(k) > 0.5;
@@ -277,34 +289,41 @@ namespace PeriDEAL
   HybridBondBasedModel<dim>::switch_critical(const VectorField &u)
   {
     const auto        &nb      = disc.neighborhood;
-    const unsigned int n_owned = disc.n_owned();
-    const double      *w       = wls_flag.begin();
-    const auto        &brk     = broken_flag;
-    (void)w;
     double            *crit    = critical.begin();
     const double      *p       = deformed.data();
-    (void)u;
-    std::uint64_t       n_critical = 0;
-    const std::int32_t *wf         = wls_mask.data();
-    const std::int32_t  owned      = std::int32_t(n_owned);
+    const std::int32_t *wf     = wls_mask.data();
+    if (prm.switching_bound)
+      {
+        std::array<const double *, dim> ud;
+        for (unsigned int d = 0; d < dim; ++d)
+          ud[d] = u[d].begin();
+        budget.advance(ud);
+      }
+    std::uint64_t n_critical = 0;
     // Only the Omega_w rows test: every bond with an Omega_w end is tested
-    // in the row of such an end (owned by this or another rank).
+    // in the row of such an end (owned by this or another rank); each of
+    // them tests all its unbroken bonds, so that its record covers them.
     for (const unsigned int i : active_wls_rows)
       {
+        if (prm.switching_bound && !budget.needs_check(i))
+          continue;
+        ++exact_node_tests;
         const double       *pi    = p + std::size_t(dim) * i;
         const double       *L2    = critical_length2.data() + nb.table_start[i];
+        const double       *iL2   = inverse_critical_length2.data() + nb.table_start[i];
         const auto          begin = nb.row_start[i];
         const unsigned int  n     = nb.row_start[i + 1] - begin;
         const std::int32_t *col   = nb.col.data() + begin;
-        const std::uint8_t *br    = brk.data() + begin;
-        const std::int32_t  lower = std::int32_t(i);
+        const std::uint8_t *br    = broken_flag.data() + begin;
+        double              q;
         unsigned int        count;
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
         if constexpr (dim == 2)
-          count = count_critical_avx512(p, pi, col, L2, br, n, lower, owned, wf);
+          count = test_row_avx512(p, pi, col, L2, iL2, br, n, q);
         else
 #endif
-          count = count_critical<dim>(p, pi, col, L2, br, n, lower, owned, wf);
+          count = test_row<dim>(p, pi, col, L2, iL2, br, n, q);
+        budget.record(i, (1. - std::sqrt(q)) * min_threshold - threshold_margin);
         if (count == 0)
           continue;
         n_critical += count;
@@ -312,7 +331,7 @@ namespace PeriDEAL
         for (unsigned int b = 0; b < n; ++b)
           {
             const std::int32_t j = col[b];
-            if (!(j > lower || j >= owned || wf[j] == 0) || br[b])
+            if (br[b])
               continue;
             const double l2 = length2<dim>(p + std::size_t(dim) * j, pi);
             if (l2 >= L2[b])
@@ -320,9 +339,10 @@ namespace PeriDEAL
                 // Both end points, a ghost one too (sent to its owner below).
                 crit[i] = 1.;
                 crit[j] = 1.;
-                // Once per bond: a bond to an Omega_w ghost is tested on
-                // both ranks, counted by the end with the lower id.
-                if (l2 > B2[b] && (j < owned || wf[j] == 0 || disc.id[i] < disc.id[j]))
+                // Once per bond: a bond between two Omega_w nodes is found
+                // from both ends (both bounds fire: each record covers it),
+                // on one rank or two; the end with the lower id counts it.
+                if (l2 > B2[b] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
                   ++overstretched;
               }
           }
@@ -333,16 +353,15 @@ namespace PeriDEAL
     critical.compress(VectorOperation::add); // marks of ghost end points to their owners
     critical.update_ghost_values();
     bool changed = false;
-    for (unsigned int i = 0; i < n_owned; ++i)
+    for (const unsigned int i : active_wls_rows)
       {
-        if (w[i] == 0.)
-          continue;
         bool hit = crit[i] > 0.;
         for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !hit; ++b)
           hit = crit[nb.col[b]] > 0.;
         if (hit)
           {
             wls_flag.local_element(i) = 0.;
+            switched_at[i]            = int(n_evaluations) - 1;
             changed                   = true;
           }
       }
@@ -374,7 +393,9 @@ namespace PeriDEAL
         for (std::size_t i = 0; i < n_local; ++i)
           deformed[dim * i + d] = (x[i][d] - xc[d]) + ud[i];
       }
-    if ((n_evaluations++ % prm.check_interval == 0) &&
+    // Without a finite s0 nothing is ever critical (and s0 is the same on
+    // every rank).
+    if ((n_evaluations++ % prm.check_interval == 0) && std::isfinite(s0) &&
         (!active_wls_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1))
       switch_critical(u);
     seconds[0] += seconds_since(start);
