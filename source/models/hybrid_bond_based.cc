@@ -1,7 +1,7 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/hybrid_bond_based.h>
 
-#include <chrono>
+#include <ctime>
 #include <immintrin.h>
 #include <complex>
 #include <map>
@@ -13,10 +13,13 @@ namespace PeriDEAL
 {
   namespace
   {
+    /** CPU time of this thread [s] (the machine may be shared: no wall time). */
     double
-    seconds_since(const std::chrono::steady_clock::time_point &start)
+    cpu_seconds()
     {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      timespec t;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+      return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
     }
 
     /**
@@ -73,10 +76,14 @@ namespace PeriDEAL
       return n_break;
     }
 
+    /** Most bond length classes of the amortized switching test. */
+    constexpr unsigned int max_classes = 4;
+
     /**
      * Exact switching test of one Omega_w row, portable: the number of
-     * unbroken bonds b with |y|^2 >= L2[b], and in @p q the maximum of
-     * |y|^2 / L2[b] = |y|^2 * iL2[b] over them (0 without unbroken bonds).
+     * unbroken bonds b with |y|^2 >= L2[b], and in @p q[k] the maximum of
+     * |y|^2 / L2[b] = |y|^2 * iL2[b] over those of length class k, i.e.
+     * r[b] <= bound[k] and (k = 0 or r[b] > bound[k - 1]) (0 if none).
      */
     template <int dim>
     unsigned int
@@ -85,20 +92,26 @@ namespace PeriDEAL
              const std::int32_t *col,
              const double       *L2,
              const double       *iL2,
+             const double       *r,
+             const double       *bound,
+             const unsigned int  n_classes,
              const std::uint8_t *br,
              const unsigned int  n,
-             double             &q)
+             double             *q)
     {
       unsigned int count = 0;
-      double       qmax  = 0.;
+      for (unsigned int k = 0; k < n_classes; ++k)
+        q[k] = 0.;
       for (unsigned int b = 0; b < n; ++b)
         if (br[b] == 0)
           {
             const double l2 = length2<dim>(p + std::size_t(dim) * col[b], pi);
             count += l2 >= L2[b];
-            qmax = std::max(qmax, l2 * iL2[b]);
+            unsigned int k = 0;
+            while (k + 1 < n_classes && r[b] > bound[k])
+              ++k;
+            q[k] = std::max(q[k], l2 * iL2[b]);
           }
-      q = qmax;
       return count;
     }
 
@@ -168,12 +181,17 @@ namespace PeriDEAL
                     const std::int32_t *col,
                     const double       *L2,
                     const double       *iL2,
+                    const double       *r,
+                    const double       *bound,
+                    const unsigned int  n_classes,
                     const std::uint8_t *br,
                     const unsigned int  n,
-                    double             &q)
+                    double             *q)
     {
       unsigned int count = 0;
-      __m512d      qmax  = _mm512_setzero_pd();
+      __m512d      qmax[max_classes];
+      for (unsigned int k = 0; k < max_classes; ++k)
+        qmax[k] = _mm512_setzero_pd();
       for (unsigned int b = 0; b < n; b += 8)
         {
           const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
@@ -186,10 +204,21 @@ namespace PeriDEAL
           const __m512d l2 = _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0));
           count += __builtin_popcount(
             _mm512_mask_cmp_pd_mask(alive, l2, _mm512_maskz_loadu_pd(alive, L2 + b), _CMP_GE_OQ));
-          qmax = _mm512_mask_max_pd(qmax, alive, qmax,
-                                    _mm512_mul_pd(l2, _mm512_maskz_loadu_pd(alive, iL2 + b)));
+          const __m512d ratio = _mm512_mul_pd(l2, _mm512_maskz_loadu_pd(alive, iL2 + b));
+          const __m512d rb    = _mm512_maskz_loadu_pd(alive, r + b);
+          __mmask8      rest  = alive;
+          for (unsigned int k = 0; k < n_classes; ++k)
+            {
+              const __mmask8 in =
+                k + 1 < n_classes ?
+                  __mmask8(rest & _mm512_cmp_pd_mask(rb, _mm512_set1_pd(bound[k]), _CMP_LE_OQ)) :
+                  rest;
+              qmax[k] = _mm512_mask_max_pd(qmax[k], in, qmax[k], ratio);
+              rest &= ~in;
+            }
         }
-      q = _mm512_reduce_max_pd(qmax);
+      for (unsigned int k = 0; k < n_classes; ++k)
+        q[k] = _mm512_reduce_max_pd(qmax[k]);
       return count;
     }
 #endif
@@ -261,9 +290,25 @@ namespace PeriDEAL
     double extent = 0.;
     for (unsigned int d = 0; d < dim; ++d)
       extent = std::max(extent, disc.lattice_size()[d] * disc.parameters().dx);
-    min_threshold    = r_min * (1. + (std::isfinite(s0) ? prm.sigma * s0 : 0.));
-    threshold_margin = 1e-9 * min_threshold + 1e-13 * extent;
-    budget.reinit(disc.position, disc.n_owned(), r_max);
+    const double stretch = 1. + (std::isfinite(s0) ? prm.sigma * s0 : 0.);
+    threshold_margin     = 1e-9 * r_min * stretch + 1e-13 * extent;
+    for (unsigned int k = 0; k < max_classes && (k == 0 || class_bound.back() < r_max); ++k)
+      class_bound.push_back(k + 1 < max_classes ? r_min * std::pow(2., k + 1) * (1. + 1e-9) :
+                                                  std::numeric_limits<double>::max());
+    class_bound.back() = std::numeric_limits<double>::max();
+    min_threshold.assign(class_bound.size(), std::numeric_limits<double>::max());
+    std::vector<double> reach(class_bound.size(), 0.);
+    for (const double r : nb.bond_length)
+      {
+        unsigned int k = 0;
+        while (k + 1 < class_bound.size() && r > class_bound[k])
+          ++k;
+        min_threshold[k] = std::min(min_threshold[k], r * stretch);
+        reach[k]         = std::max(reach[k], r);
+      }
+    budget.resize(class_bound.size());
+    for (unsigned int k = 0; k < budget.size(); ++k)
+      budget[k].reinit(disc.position, disc.n_owned(), std::max(reach[k], r_min));
     switched_at.assign(disc.n_owned(), -1);
     update_row_lists();
   }
@@ -297,7 +342,8 @@ namespace PeriDEAL
         std::array<const double *, dim> ud;
         for (unsigned int d = 0; d < dim; ++d)
           ud[d] = u[d].begin();
-        budget.advance(ud);
+        for (auto &b : budget)
+          b.advance(ud);
       }
     std::uint64_t n_critical = 0;
     // Only the Omega_w rows test: every bond with an Omega_w end is tested
@@ -305,8 +351,14 @@ namespace PeriDEAL
     // them tests all its unbroken bonds, so that its record covers them.
     for (const unsigned int i : active_wls_rows)
       {
-        if (prm.switching_bound && !budget.needs_check(i))
-          continue;
+        if (prm.switching_bound)
+          {
+            bool needed = false;
+            for (const auto &b : budget)
+              needed = needed || b.needs_check(i);
+            if (!needed)
+              continue;
+          }
         ++exact_node_tests;
         const double       *pi    = p + std::size_t(dim) * i;
         const double       *L2    = critical_length2.data() + nb.table_start[i];
@@ -315,15 +367,18 @@ namespace PeriDEAL
         const unsigned int  n     = nb.row_start[i + 1] - begin;
         const std::int32_t *col   = nb.col.data() + begin;
         const std::uint8_t *br    = broken_flag.data() + begin;
-        double              q;
+        const double       *r     = nb.bond_length.data() + nb.table_start[i];
+        const unsigned int  n_classes = class_bound.size();
+        double              q[max_classes];
         unsigned int        count;
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
         if constexpr (dim == 2)
-          count = test_row_avx512(p, pi, col, L2, iL2, br, n, q);
+          count = test_row_avx512(p, pi, col, L2, iL2, r, class_bound.data(), n_classes, br, n, q);
         else
 #endif
-          count = test_row<dim>(p, pi, col, L2, iL2, br, n, q);
-        budget.record(i, (1. - std::sqrt(q)) * min_threshold - threshold_margin);
+          count = test_row<dim>(p, pi, col, L2, iL2, r, class_bound.data(), n_classes, br, n, q);
+        for (unsigned int k = 0; k < n_classes; ++k)
+          budget[k].record(i, (1. - std::sqrt(q[k])) * min_threshold[k] - threshold_margin);
         if (count == 0)
           continue;
         n_critical += count;
@@ -377,7 +432,7 @@ namespace PeriDEAL
   void
   HybridBondBasedModel<dim>::compute_forces(const VectorField &u, VectorField &force)
   {
-    auto start = std::chrono::steady_clock::now();
+    double start = cpu_seconds();
     // Deformed positions x - x_c + u (x_c the lattice centre, the same on
     // every rank) of all local nodes, interleaved.
     const std::vector<Point<dim>> &x       = disc.position;
@@ -398,11 +453,11 @@ namespace PeriDEAL
     if ((n_evaluations++ % prm.check_interval == 0) && std::isfinite(s0) &&
         (!active_wls_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1))
       switch_critical(u);
-    seconds[0] += seconds_since(start);
+    seconds[0] += (cpu_seconds() - start);
 
     // Omega_s: the nonlinear PMB force (3.1) with breaking (2.34), as in
     // BondBasedOperator: force k (l - r) y / l, break when l - r > s0 r.
-    start               = std::chrono::steady_clock::now();
+    start               = cpu_seconds();
     const auto   &nb    = disc.neighborhood;
     auto         &flags = broken_flag;
     bool          broke = false;
@@ -430,10 +485,10 @@ namespace PeriDEAL
           force[d].local_element(i) = f[d];
       }
     op_stale = op_stale || broke;
-    seconds[1] += seconds_since(start);
+    seconds[1] += (cpu_seconds() - start);
 
     // Omega_w: F_i = sum_c W_ic u_c, dim x dim blocks (row-major).
-    start = std::chrono::steady_clock::now();
+    start = cpu_seconds();
     std::array<const double *, dim> ud;
     for (unsigned int d = 0; d < dim; ++d)
       ud[d] = u[d].begin();
@@ -453,7 +508,7 @@ namespace PeriDEAL
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
       }
-    seconds[2] += seconds_since(start);
+    seconds[2] += (cpu_seconds() - start);
   }
 
   template <int dim>

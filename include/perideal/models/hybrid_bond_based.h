@@ -84,6 +84,11 @@ namespace PeriDEAL
    * tests/hybrid_kw, kw: identical switch evaluations and damage per node).
    * A margin of 1e-9 min_b T_b (plus 1e-13 of the lattice extent) is
    * subtracted from the slack against round-off of positions and bounds.
+   * The bound of a StretchBudget grows with its reach (the width of the
+   * blocks), the slack with the shortest bond; so the bonds are split into
+   * length classes (r_min 2^k, r_min 2^(k+1)] (up to four), each with its
+   * own StretchBudget (reach: the class's longest bond) and slack (its
+   * shortest bond), and a node is tested when one class's bound fires.
    * Switching is rank independent: each rank marks the owned end points of
    * its critical bonds (a bond to a ghost is tested on both ranks with
    * bitwise the same length), one global sum tells whether anything is
@@ -158,7 +163,8 @@ namespace PeriDEAL
       op.set_broken_flags(flags);
       broken_flag = flags;
       op_stale    = false;
-      budget.invalidate(); // bonds may have been restored
+      for (auto &b : budget) // bonds may have been restored
+        b.invalidate();
     }
     std::uint64_t
     n_broken_bonds() const override
@@ -236,7 +242,7 @@ namespace PeriDEAL
     {
       return *wls;
     }
-    /** Wall time [switching test, standard rows, WLS rows] of compute_forces() on this rank. */
+    /** CPU time [switching test, standard rows, WLS rows] of compute_forces() on this rank (thread). */
     std::array<double, 3> seconds{{0., 0., 0.}};
     /** @} */
 
@@ -274,10 +280,16 @@ namespace PeriDEAL
     std::vector<unsigned int> standard_rows, active_wls_rows;
     /** Per bond table entry: (r (1 + sigma s0))^2, (r (1 + s0))^2, 1 / (r (1 + sigma s0))^2. */
     std::vector<double> critical_length2, breaking_length2, inverse_critical_length2;
-    /** Growth bound of the bond lengths of the Omega_w nodes since their last exact test. */
-    StretchBudget<dim> budget;
-    /** min_b r_b (1 + sigma s0) minus the round-off margin; the margin. */
-    double min_threshold = 0., threshold_margin = 0.;
+    /**
+     * Bonds in length classes (r_min 2^k, r_min 2^(k+1)] (the last one
+     * open), each with its growth bound of the Omega_w nodes' bond lengths
+     * since their last exact test, the upper length bound of the class and
+     * min r (1 + sigma s0) over it.
+     */
+    std::vector<StretchBudget<dim>> budget;
+    std::vector<double>             class_bound, min_threshold;
+    /** Round-off margin subtracted from every slack. */
+    double threshold_margin = 0.;
     std::vector<int> switched_at;
     std::uint64_t    exact_node_tests = 0;
     /** Broken flags of the owned rows (op's copy is updated when a bond breaks). */
