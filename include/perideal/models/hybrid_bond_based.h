@@ -242,8 +242,12 @@ namespace PeriDEAL
     {
       return *wls;
     }
-    /** CPU time [switching test, standard rows, WLS rows] of compute_forces() on this rank (thread). */
-    std::array<double, 3> seconds{{0., 0., 0.}};
+    /**
+     * CPU time [switching test, standard rows, WLS rows, of the switching
+     * test: the StretchBudget updates] of compute_forces() on this rank
+     * (thread).
+     */
+    std::array<double, 4> seconds{{0., 0., 0., 0.}};
     /** @} */
 
   private:
@@ -272,6 +276,14 @@ namespace PeriDEAL
     std::unique_ptr<WlsQuadrature<dim>> wls;
     /** Per owned node: the WLS row index, or -1. */
     std::vector<int> wls_row;
+    /**
+     * The WLS rows packed for the vectorized force (2D): per row, chunks of
+     * 8 collocation nodes (padded with zero weights), each with 8 columns
+     * and the 4 x 8 weights W00, W01, W10, W11.
+     */
+    std::vector<std::uint64_t> packed_start;
+    std::vector<std::int32_t>  packed_col;
+    std::vector<double>        packed_weight;
     /** 1 in Omega_w (local, with ghosts); critical end points (local, with ghosts). */
     Vector wls_flag, critical;
     /** wls_flag as bytes (local, with ghosts), for the switching test. */

@@ -135,19 +135,41 @@ namespace PeriDEAL
             box[2 * dim * b + 2 * d]     = std::numeric_limits<double>::max();
             box[2 * dim * b + 2 * d + 1] = -std::numeric_limits<double>::max();
           }
+      // Nodes come in runs of the same block (lattice order): keep the run's
+      // box in registers and merge it into the block's box at the run's end.
+      std::array<double, dim> lo, hi;
+      std::uint32_t           current = n > 0 ? block[0] : 0;
+      const auto              flush   = [&]() {
+        double *bx = box.data() + 2 * dim * std::size_t(current);
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            bx[2 * d]     = std::min(bx[2 * d], lo[d]);
+            bx[2 * d + 1] = std::max(bx[2 * d + 1], hi[d]);
+          }
+      };
+      lo.fill(std::numeric_limits<double>::max());
+      hi.fill(-std::numeric_limits<double>::max());
       for (std::size_t k = 0; k < n; ++k)
         {
-          double *bx = box.data() + 2 * dim * std::size_t(block[k]);
+          if (block[k] != current)
+            {
+              flush();
+              current = block[k];
+              lo.fill(std::numeric_limits<double>::max());
+              hi.fill(-std::numeric_limits<double>::max());
+            }
           for (unsigned int d = 0; d < dim; ++d)
             {
               const double inc      = u[d][k] - previous[dim * k + d];
               previous[dim * k + d] = u[d][k];
-              bx[2 * d]             = std::min(bx[2 * d], inc);
-              bx[2 * d + 1]         = std::max(bx[2 * d + 1], inc);
+              lo[d]                 = std::min(lo[d], inc);
+              hi[d]                 = std::max(hi[d], inc);
               if (k < n_track)
                 increment[dim * k + d] = inc;
             }
         }
+      if (n > 0)
+        flush();
       // Union over the 3^dim blocks around each block (one direction at a
       // time: separable), empty blocks contribute nothing.
       dilated = box;
