@@ -8,7 +8,8 @@
 //             standard scheme (damage, crack length and angle; Omega_s grows
 //             only near the crack);
 //  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage;
-//  bad_input: ParameterError for bad Hybrid entries.
+//  bad_input: ParameterError for bad Hybrid entries;
+//  stretch_budget: the bound of StretchBudget (stretch_budget_test.h).
 
 #include <deal.II/base/mpi.h>
 
@@ -19,6 +20,7 @@
 
 #include "../check.h"
 #include "kalthoff_winkler_case.h"
+#include "stretch_budget_test.h"
 
 #include <map>
 
@@ -158,6 +160,12 @@ namespace
     auto ps      = kalthoff_winkler(dx, delta, T, "standard", 0.8, "kw-standard");
     ps.time_step = hybrid.integrator().time_step();
     MechanicsSolver<2> standard(MPI_COMM_SELF, ps);
+    // The reference of the amortized switching test: (3.80) on every bond
+    // at every step.
+    auto pe                   = ph;
+    pe.hybrid.switching_bound = false;
+    pe.output_directory       = "kw-hybrid-every-step";
+    MechanicsSolver<2> every(MPI_COMM_SELF, pe);
     const auto        &disc = hybrid.discretization();
     const auto        *hm   = hybrid.hybrid_model();
     std::vector<bool>  initial_wls(disc.n_owned());
@@ -165,15 +173,49 @@ namespace
       initial_wls[i] = hm->scheme().local_element(i) > 0.5;
     const double initial_fraction = hm->standard_fraction();
     hybrid.run();
+    every.run();
     standard.run();
     const auto mh = hybrid.measure(), ms = standard.measure();
     const auto dh = damage_by_id(hybrid), ds = damage_by_id(standard);
+
+    // Amortized (StretchBudget) vs every-step test: the same node switches
+    // at the same force evaluation, hence bitwise the same run.
+    const auto *he = every.hybrid_model();
+    std::map<types::particle_index, int> every_switch;
+    for (unsigned int i = 0; i < every.discretization().n_owned(); ++i)
+      every_switch[every.discretization().id[i]] = he->switch_evaluation()[i];
+    unsigned int differ = 0, n_switched = 0;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        differ += hm->switch_evaluation()[i] != every_switch.at(disc.id[i]);
+        n_switched += hm->switch_evaluation()[i] >= 0;
+      }
+    const auto de        = damage_by_id(every);
+    double     damage_diff = 0.;
+    for (const auto &[id, d] : dh)
+      damage_diff = std::max(damage_diff, std::abs(d - de.at(id)));
+    check(n_switched > 0 && differ == 0 && hm->n_switch_events() == he->n_switch_events() &&
+            hm->n_overstretched_bonds() == he->n_overstretched_bonds(),
+          "amortized switching test: " + std::to_string(n_switched) +
+            " switched nodes, each at the same force evaluation as with the every-step test (" +
+            std::to_string(differ) + " differ; " + std::to_string(hm->n_switch_events()) + " / " +
+            std::to_string(he->n_switch_events()) + " switch events)");
+    check(damage_diff == 0. &&
+            hybrid.model().n_broken_bonds() == every.model().n_broken_bonds(),
+          "amortized vs every-step: max |damage difference| = " + sci(damage_diff) +
+            ", broken bonds " + std::to_string(hybrid.model().n_broken_bonds()) + " / " +
+            std::to_string(every.model().n_broken_bonds()));
+    // The point of the bound: most exact node tests are skipped.
+    check(hm->n_exact_node_tests() < he->n_exact_node_tests() / 4,
+          "exact node tests of (3.80): " + std::to_string(hm->n_exact_node_tests()) +
+            " (amortized) vs " + std::to_string(he->n_exact_node_tests()) + " (every step)");
     if (root())
       std::cout << "  KW dx = 1, m = 4, " << disc.n_global() << " nodes, "
                 << hybrid.integrator().step() << " steps: Omega_s " << 100. * initial_fraction
                 << "% -> " << 100. * hm->standard_fraction() << "%, stepping "
                 << standard.stepping_wall_time() << " s (standard) / "
-                << hybrid.stepping_wall_time() << " s (hybrid); switch events "
+                << hybrid.stepping_wall_time() << " s (hybrid), "
+                << every.stepping_wall_time() << " s (hybrid, every-step test); switch events "
                 << hm->n_switch_events() << "\n  crack angle " << ms.crack_angle << " / "
                 << mh.crack_angle << " deg, length " << ms.crack_length << " / "
                 << mh.crack_length << " mm, broken bonds " << standard.model().n_broken_bonds()
@@ -354,5 +396,6 @@ main(int argc, char **argv)
              {{"patch", patch},
               {"kw", kw},
               {"rank_invariance", rank_invariance},
-              {"bad_input", bad_input}});
+              {"bad_input", bad_input},
+              {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

@@ -2,7 +2,7 @@
 # fracture: patch test, Kalthoff-Winkler at CI size against the standard
 # scheme, rank invariance, bad input (one executable).
 perideal_add_test_program(hybrid_kw_tests ${CMAKE_CURRENT_LIST_DIR}/hybrid_kw_tests.cc)
-foreach(_t patch kw bad_input)
+foreach(_t patch kw bad_input stretch_budget)
   perideal_add_test(NAME hybrid_kw.${_t} COMMAND $<TARGET_FILE:hybrid_kw_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME hybrid_kw.rank_invariance.np2 NPROCS 2

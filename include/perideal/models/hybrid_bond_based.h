@@ -3,6 +3,7 @@
 
 #include <perideal/discretization/wls_quadrature.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/models/stretch_budget.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
 #include <cstdint>
@@ -29,6 +30,13 @@ namespace PeriDEAL
      * in between are caught (and counted) at the next test.
      */
     unsigned int check_interval = 1;
+    /**
+     * Skip the exact test of (3.80) at the Omega_w nodes whose bonds provably
+     * cannot have become critical since their last exact test
+     * (StretchBudget). The outcome is that of the test of every bond; false
+     * tests every bond at every test (the reference, for verification).
+     */
+    bool switching_bound = true;
   };
 
   /**
@@ -57,7 +65,30 @@ namespace PeriDEAL
    * evaluation if s > s0). Bonds found with s > s0 while still in Omega_w
    * are counted (n_overstretched_bonds(); 0 means sigma was small enough).
    * The test compares squared lengths with precomputed squared thresholds
-   * (no square root) and visits each bond between owned nodes once.
+   * (no square root).
+   *
+   * Amortized test (HybridMechanicsParameters::switching_bound, default):
+   * a node i of Omega_w is tested exactly (all its unbroken bonds) only
+   * when StretchBudget says that some bond of i may have reached the
+   * threshold T_b = r_b (1 + sigma s0) since i's last exact test. At that
+   * test, with q_i = max_b |y_b|^2 / T_b^2 over the unbroken bonds of i,
+   * every bond satisfies |y_b| <= sqrt(q_i) T_b, so until the growth bound
+   * g_i of the bond lengths reaches the slack (1 - sqrt(q_i)) min_b T_b,
+   * |y_b| <= sqrt(q_i) T_b + g_i < T_b: no bond of i is critical, and the
+   * exact test of i would find nothing. Bonds only break (the intact set
+   * shrinks), and a node never returns to Omega_w, so a record stays valid
+   * while i is in Omega_w. Every critical bond has an Omega_w end whose
+   * bound therefore fires, and that end tests it exactly: the critical bonds
+   * found at every test, hence the switched nodes and the evaluation at
+   * which each switches, are those of the test of every bond (verified by
+   * tests/hybrid_kw, kw: identical switch evaluations and damage per node).
+   * A margin of 1e-9 min_b T_b (plus 1e-13 of the lattice extent) is
+   * subtracted from the slack against round-off of positions and bounds.
+   * The bound of a StretchBudget grows with its reach (the width of the
+   * blocks), the slack with the shortest bond; so the bonds are split into
+   * length classes (r_min 2^k, r_min 2^(k+1)] (up to four), each with its
+   * own StretchBudget (reach: the class's longest bond) and slack (its
+   * shortest bond), and a node is tested when one class's bound fires.
    * Switching is rank independent: each rank marks the owned end points of
    * its critical bonds (a bond to a ghost is tested on both ranks with
    * bitwise the same length), one global sum tells whether anything is
@@ -132,6 +163,8 @@ namespace PeriDEAL
       op.set_broken_flags(flags);
       broken_flag = flags;
       op_stale    = false;
+      for (auto &b : budget) // bonds may have been restored
+        b.invalidate();
     }
     std::uint64_t
     n_broken_bonds() const override
@@ -188,14 +221,33 @@ namespace PeriDEAL
     {
       return switch_events;
     }
+    /**
+     * Per owned node: the force evaluation (0-based count of
+     * compute_forces() calls) before which it switched to Omega_s, or -1.
+     */
+    const std::vector<int> &
+    switch_evaluation() const
+    {
+      return switched_at;
+    }
+    /** Number of exact node tests of (3.80) so far on this rank (a node per test). */
+    std::uint64_t
+    n_exact_node_tests() const
+    {
+      return exact_node_tests;
+    }
     /** The WLS quadrature of the initial Omega_w rows. */
     const WlsQuadrature<dim> &
     wls_quadrature() const
     {
       return *wls;
     }
-    /** Wall time [switching test, standard rows, WLS rows] of compute_forces() on this rank. */
-    std::array<double, 3> seconds{{0., 0., 0.}};
+    /**
+     * CPU time [switching test, standard rows, WLS rows, of the switching
+     * test: the StretchBudget updates] of compute_forces() on this rank
+     * (thread).
+     */
+    std::array<double, 4> seconds{{0., 0., 0., 0.}};
     /** @} */
 
   private:
@@ -224,14 +276,34 @@ namespace PeriDEAL
     std::unique_ptr<WlsQuadrature<dim>> wls;
     /** Per owned node: the WLS row index, or -1. */
     std::vector<int> wls_row;
+    /**
+     * The WLS rows packed for the vectorized force (2D): per row, chunks of
+     * 8 collocation nodes (padded with zero weights), each with 8 columns
+     * and the 4 x 8 weights W00, W01, W10, W11.
+     */
+    std::vector<std::uint64_t> packed_start;
+    std::vector<std::int32_t>  packed_col;
+    std::vector<double>        packed_weight;
     /** 1 in Omega_w (local, with ghosts); critical end points (local, with ghosts). */
     Vector wls_flag, critical;
     /** wls_flag as bytes (local, with ghosts), for the switching test. */
     std::vector<std::int32_t> wls_mask;
     /** Owned Omega_s rows; owned Omega_w rows. */
     std::vector<unsigned int> standard_rows, active_wls_rows;
-    /** Per bond table entry: (r (1 + sigma s0))^2 and (r (1 + s0))^2. */
-    std::vector<double> critical_length2, breaking_length2;
+    /** Per bond table entry: (r (1 + sigma s0))^2, (r (1 + s0))^2, 1 / (r (1 + sigma s0))^2. */
+    std::vector<double> critical_length2, breaking_length2, inverse_critical_length2;
+    /**
+     * Bonds in length classes (r_min 2^k, r_min 2^(k+1)] (the last one
+     * open), each with its growth bound of the Omega_w nodes' bond lengths
+     * since their last exact test, the upper length bound of the class and
+     * min r (1 + sigma s0) over it.
+     */
+    std::vector<StretchBudget<dim>> budget;
+    std::vector<double>             class_bound, min_threshold;
+    /** Round-off margin subtracted from every slack. */
+    double threshold_margin = 0.;
+    std::vector<int> switched_at;
+    std::uint64_t    exact_node_tests = 0;
     /** Broken flags of the owned rows (op's copy is updated when a bond breaks). */
     std::vector<std::uint8_t> broken_flag;
     mutable bool              op_stale = false;
