@@ -11,6 +11,7 @@
 //   kw_multiadaptive_benchmark [--coarse-dx 1] [--fine-dx 0.5] [--delta 4]
 //                              [--end-time 87.5e-6] [--rounds 3]
 //                              [--directory <tmp>/perideal-kw-multiadaptive]
+//                              [--damage-file <file>]
 //
 // The runs are interleaved (uniform fine, adaptive standard, adaptive
 // hybrid, repeated --rounds times) and each figure is the median over the
@@ -138,6 +139,7 @@ main(int argc, char **argv)
   kw.fine_dx          = 0.5;
   kw.delta            = 4.;
   unsigned int rounds = 3;
+  std::string  damage_file;
   std::string  dir =
     (std::filesystem::temp_directory_path() / "perideal-kw-multiadaptive").string();
   for (int i = 1; i + 1 < argc; i += 2)
@@ -156,6 +158,8 @@ main(int argc, char **argv)
         rounds = static_cast<unsigned int>(val);
       else if (key == "--directory")
         dir = argv[i + 1];
+      else if (key == "--damage-file")
+        damage_file = argv[i + 1];
       else
         {
           std::fprintf(stderr, "unknown option %s %s\n", key.c_str(), argv[i + 1]);
@@ -201,6 +205,24 @@ main(int argc, char **argv)
       wall[name] = median(w);
     }
   const auto &ref = runs["uniform_fine"].back();
+  if (!damage_file.empty())
+    {
+      // x y and the damage of the uniform fine, adaptive standard and
+      // adaptive hybrid runs per fine node (gnuplot blocks per row).
+      std::FILE         *out = std::fopen(damage_file.c_str(), "w");
+      const unsigned int nx  = std::lround(100. / kw.fine_dx);
+      for (std::size_t i = 0; out && i < ref.damage.size(); ++i)
+        {
+          std::fprintf(out, "%g %g %.4f %.4f %.4f\n", (i % nx + 0.5) * kw.fine_dx,
+                       -100. + (i / nx + 0.5) * kw.fine_dx, ref.damage[i],
+                       runs["adaptive_standard"].back().damage[i],
+                       runs["adaptive_hybrid"].back().damage[i]);
+          if (i % nx == nx - 1)
+            std::fprintf(out, "\n");
+        }
+      if (out)
+        std::fclose(out);
+    }
   for (const auto &name : names)
     {
       const Run  &r = runs[name].back();

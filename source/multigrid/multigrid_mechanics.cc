@@ -933,7 +933,10 @@ namespace PeriDEAL
       double                *R      = B.reaction.data();
       const std::size_t      n_bits = 8 * B.n_bytes;
       const unsigned int     H = B.offset.size(), n_pairs = H / 2;
-      std::size_t            zeroed = 0, e = 0;
+      // Reactions are written from the first chunk with work on: zero
+      // from there (zero_begin) up to what the chunks reach (zeroed).
+      std::size_t            zero_begin = 0, zeroed = 0, e = 0;
+      bool                   started = false;
       const std::size_t      E      = B.evaluated.size();
       auto                  &A      = a[g];
       B.newly_broken.clear();
@@ -946,6 +949,11 @@ namespace PeriDEAL
           const bool         work = B.chunk_live[c0 / C];
           if (work)
             {
+              if (!started)
+                {
+                  zero_begin = zeroed = c0;
+                  started             = true;
+                }
               const std::size_t need = std::min<std::size_t>(N, c0 + n + B.o_max + 8);
               for (unsigned int d = 0; d < dim; ++d)
                 std::fill(R + d * N + zeroed, R + d * N + std::max(zeroed, need), 0.);
@@ -983,7 +991,9 @@ namespace PeriDEAL
               const unsigned int i = B.evaluated[e];
               for (unsigned int d = 0; d < dim; ++d)
                 A[dim * i + d] =
-                  ((work ? acc[d * C + P - c0] : 0.) - (P < zeroed ? R[d * N + P] : 0.)) * inv_rho;
+                  ((work ? acc[d * C + P - c0] : 0.) -
+                   (P >= zero_begin && P < zeroed ? R[d * N + P] : 0.)) *
+                  inv_rho;
             }
         }
       // Both copies of the newly broken bonds (rare).
@@ -1355,10 +1365,19 @@ namespace PeriDEAL
         {
           const Lattice     &L = grids[g];
           const unsigned int S = L.offset.size();
+          // A bond crossing the segment has its end within the bond
+          // length (at most radius dx) of the segment's bounding box.
+          const double reach = L.radius * L.dx;
           for (unsigned int i = 0; i < L.n_nodes; ++i)
             {
               const auto       ix = L.index(i);
               const Point<dim> xi = L.point(i);
+              bool             near = true;
+              for (unsigned int d = 0; d < dim; ++d)
+                near = near && xi[d] >= std::min(p[d], q[d]) - reach &&
+                       xi[d] <= std::max(p[d], q[d]) + reach;
+              if (!near)
+                continue;
               for (unsigned int k = 0; k < S; ++k)
                 {
                   auto jx = ix;
