@@ -1700,8 +1700,10 @@ namespace PeriDEAL
         monitor(s);
       for (unsigned int k = 1; k <= r.steps; ++k)
         {
-          const auto start = std::chrono::steady_clock::now();
+          const auto   start = std::chrono::steady_clock::now();
+          const double cpu   = thread_cpu_seconds();
           s.advance();
+          r.cpu_seconds += thread_cpu_seconds() - cpu;
           r.seconds += seconds_since(start);
           if (monitor && ((interval > 0 && k % interval == 0) || k == r.steps))
             monitor(s);

@@ -488,6 +488,8 @@ namespace PeriDEAL
         double       angle = 0., length = 0.;
         /** Wall time of the time loop (setup excluded) [s]. */
         double seconds = 0.;
+        /** Thread CPU time of the time loop (setup excluded) [s]. */
+        double cpu_seconds = 0.;
         /** MechanicsSolver::timing (CPU): forces, interpolation, switching test, switching. */
         std::array<double, 4> timing{{0., 0., 0., 0.}};
       };
