@@ -70,8 +70,9 @@ namespace PeriDEAL
       constexpr unsigned int sweep_chunk = 512;
 
 #ifdef PERIDEAL_MULTIGRID_AVX512
-      // NO positive offsets hs[.] of the sweep over box positions [c0, c0 + n)
-      // (multiples of 8), eight positions per iteration: bond (L, L + o) for
+      // NO positive offsets hs[.] of the sweep over the groups of eight box
+      // positions c0 + 8 groups[.] (the chunk's groups with a live bit; c0 a
+      // multiple of 8), eight positions per iteration: bond (L, L + o) for
       // every live bit; the force on L is accumulated in acc (stride C), its
       // reaction on L + o in reaction (stride N). 1/|y| from vrsqrt14pd and
       // two Newton steps (relative error ~1e-16). A bond with
@@ -87,7 +88,8 @@ namespace PeriDEAL
                     const std::size_t                              N,
                     const unsigned int                             C,
                     const std::size_t                              c0,
-                    const unsigned int                             n,
+                    const std::uint8_t                            *groups,
+                    const unsigned int                             n_groups,
                     const long                                    *o,
                     const unsigned int                            *hs,
                     const double                                  *k,
@@ -105,9 +107,10 @@ namespace PeriDEAL
           }
         const __m512d vs0 = _mm512_set1_pd(s0), one = _mm512_set1_pd(1.),
                       half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
-        for (unsigned int v = 0; v < n; v += 8)
+        for (unsigned int gi = 0; gi < n_groups; ++gi)
           {
-            __mmask8 alive[NO], any = 0;
+            const unsigned int v = 8 * groups[gi];
+            __mmask8           alive[NO], any = 0;
             for (int q = 0; q < NO; ++q)
               any |= alive[q] = bits[q][v / 8];
             if (any == 0)
@@ -547,11 +550,25 @@ namespace PeriDEAL
               Z[w] = I[w] & (E[w] | shifted);
             }
         }
-      const std::size_t words_per_chunk = sweep_chunk / 64;
-      B.chunk_live.assign(W / words_per_chunk, 0);
+      // Groups of eight positions with a live bit for some offset, per
+      // chunk (the sweep visits only these).
+      std::vector<std::uint64_t> any(W, 0);
       for (unsigned int h = 0; h < H; ++h)
         for (std::size_t w = 0; w < W; ++w)
-          B.chunk_live[w / words_per_chunk] |= B.live[h * W + w] != 0;
+          any[w] |= B.live[h * W + w];
+      const unsigned int groups_per_chunk = sweep_chunk / 8;
+      B.group_start.assign(1, 0);
+      B.groups.clear();
+      for (std::size_t c = 0; c < W * 64 / sweep_chunk; ++c)
+        {
+          for (unsigned int gi = 0; gi < groups_per_chunk; ++gi)
+            {
+              const std::size_t byte = c * groups_per_chunk + gi;
+              if ((any[byte / 8] >> (8 * (byte % 8))) & 0xFFu)
+                B.groups.push_back(gi);
+            }
+          B.group_start.push_back(B.groups.size());
+        }
       B.valid = true;
     }
 
@@ -946,7 +963,9 @@ namespace PeriDEAL
       for (std::size_t c0 = 0; c0 < n_bits && e < E; c0 += C)
         {
           const unsigned int n    = std::min<std::size_t>(C, n_bits - c0);
-          const bool         work = B.chunk_live[c0 / C];
+          const std::uint8_t *groups   = B.groups.data() + B.group_start[c0 / C];
+          const unsigned int  n_groups = B.group_start[c0 / C + 1] - B.group_start[c0 / C];
+          const bool          work     = n_groups > 0;
           if (work)
             {
               if (!started)
@@ -964,14 +983,16 @@ namespace PeriDEAL
               for (unsigned int h = 0; h < n_pairs; ++h)
                 {
                   const unsigned int hs[2] = {h, h + n_pairs};
-                  sweep_offsets<dim, 2>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, n,
+                  sweep_offsets<dim, 2>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
+                                        n_groups,
                                         B.offset.data(), hs, B.coefficient.data(),
                                         B.length.data(), s_break, B.newly_broken);
                 }
               if (H % 2)
                 {
                   const unsigned int hs[1] = {H - 1};
-                  sweep_offsets<dim, 1>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, n,
+                  sweep_offsets<dim, 1>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
+                                        n_groups,
                                         B.offset.data(), hs, B.coefficient.data(),
                                         B.length.data(), s_break, B.newly_broken);
                 }

@@ -338,10 +338,12 @@ namespace PeriDEAL
         /**
          * Per positive offset (n_bytes each, as 64-bit words): intact bits
          * (both ends in the lattice, bond unbroken) and live bits (intact
-         * and an evaluated end); chunks with any live bit.
+         * and an evaluated end); per chunk the groups of 8 positions with
+         * a live bit (CSR: group_start per chunk, groups within the chunk).
          */
         std::vector<std::uint64_t> intact, live;
-        std::vector<std::uint8_t>  chunk_live;
+        std::vector<unsigned int>  group_start;
+        std::vector<std::uint8_t>  groups;
         /** Evaluated nodes as bits per box position (padded for shifted reads). */
         std::vector<std::uint64_t> evaluated_bits;
         bool                       intact_valid = false;
