@@ -13,8 +13,9 @@
 //                              [--directory <tmp>/perideal-kw-multiadaptive]
 //                              [--damage-file <file>]
 //
-// The runs are interleaved (uniform fine, adaptive standard, adaptive
-// hybrid, repeated --rounds times) and each figure is the median over the
+// The runs are interleaved (uniform fine by the library, uniform fine by
+// the two-grid solver, adaptive standard, adaptive hybrid, repeated
+// --rounds times) and each figure is the median over the
 // rounds of the thread CPU time of set-up + time loop: on a shared machine
 // the CPU time does not depend on the other processes' load as the wall
 // time does. Prints `key: value` lines (kw_<model>_...,
@@ -168,7 +169,12 @@ main(int argc, char **argv)
     }
   std::printf("kw_coarse_dx: %g\nkw_fine_dx: %g\nkw_delta: %g\nkw_rounds: %u\n", kw.coarse_dx,
               kw.fine_dx, kw.delta, rounds);
-  const std::vector<std::string> names{"uniform_fine", "adaptive_standard", "adaptive_hybrid"};
+  // uniform_fine: the library's standard scheme (the reference of the
+  // speed-up keys); multigrid_uniform_fine: the two-grid solver's own
+  // uniform fine model (the same lattice sweep idea, without the library's
+  // vector/Verlet layers), reported as a second reference.
+  const std::vector<std::string> names{"uniform_fine", "multigrid_uniform_fine",
+                                       "adaptive_standard", "adaptive_hybrid"};
   std::map<std::string, std::vector<Run>> runs;
   try
     {
@@ -183,6 +189,7 @@ main(int argc, char **argv)
       for (unsigned int round = 0; round < rounds; ++round)
         {
           runs["uniform_fine"].push_back(run_library(kw, dt, dir));
+          runs["multigrid_uniform_fine"].push_back(run_multigrid(kw, MGModel::uniform_fine));
           runs["adaptive_standard"].push_back(run_multigrid(kw, MGModel::adaptive_standard));
           runs["adaptive_hybrid"].push_back(run_multigrid(kw, MGModel::adaptive_hybrid));
         }
@@ -207,14 +214,16 @@ main(int argc, char **argv)
   const auto &ref = runs["uniform_fine"].back();
   if (!damage_file.empty())
     {
-      // x y and the damage of the uniform fine, adaptive standard and
-      // adaptive hybrid runs per fine node (gnuplot blocks per row).
+      // x y and the damage of the uniform fine (library, two-grid solver),
+      // adaptive standard and adaptive hybrid runs per fine node (gnuplot
+      // blocks per row).
       std::FILE         *out = std::fopen(damage_file.c_str(), "w");
       const unsigned int nx  = std::lround(100. / kw.fine_dx);
       for (std::size_t i = 0; out && i < ref.damage.size(); ++i)
         {
-          std::fprintf(out, "%g %g %.4f %.4f %.4f\n", (i % nx + 0.5) * kw.fine_dx,
+          std::fprintf(out, "%g %g %.4f %.4f %.4f %.4f\n", (i % nx + 0.5) * kw.fine_dx,
                        -100. + (i / nx + 0.5) * kw.fine_dx, ref.damage[i],
+                       runs["multigrid_uniform_fine"].back().damage[i],
                        runs["adaptive_standard"].back().damage[i],
                        runs["adaptive_hybrid"].back().damage[i]);
           if (i % nx == nx - 1)
@@ -246,13 +255,16 @@ main(int argc, char **argv)
           // Damage maps: fine nodes whose damage differs from the uniform
           // fine run's by more than 0.2, against that run's damaged nodes.
           unsigned int differ = 0, damaged = 0;
+          double       max_diff = 0.;
           for (std::size_t i = 0; i < ref.damage.size(); ++i)
             {
               damaged += ref.damage[i] > 0.2;
               differ += std::abs(r.damage[i] - ref.damage[i]) > 0.2;
+              max_diff = std::max(max_diff, std::abs(r.damage[i] - ref.damage[i]));
             }
-          std::printf("kw_%s_damage_differs_nodes: %u\nkw_%s_damaged_nodes_uniform_fine: %u\n", n,
-                      differ, n, damaged);
+          std::printf("kw_%s_damage_differs_nodes: %u\nkw_%s_damaged_nodes_uniform_fine: %u\n"
+                      "kw_%s_max_damage_difference: %.3g\n",
+                      n, differ, n, damaged, n, max_diff);
         }
       std::printf("kw_%s_crack_angle: %.6g\nkw_%s_crack_length: %.6g\n", n, r.angle, n, r.length);
     }
@@ -262,9 +274,11 @@ main(int argc, char **argv)
                   cpu["uniform_fine"] / cpu[name]);
       std::printf("kw_wall_speedup_%s_over_uniform_fine: %.4g\n", name.c_str(),
                   wall["uniform_fine"] / wall[name]);
+      std::printf("kw_speedup_%s_over_multigrid_uniform_fine: %.4g\n", name.c_str(),
+                  cpu["multigrid_uniform_fine"] / cpu[name]);
     }
-  std::printf("\n| | uniform fine (library sweep) | adaptive standard | adaptive hybrid |\n"
-              "|---|---|---|---|\n");
+  std::printf("\n| | uniform fine (library sweep) | uniform fine (two-grid solver) | adaptive "
+              "standard | adaptive hybrid |\n|---|---|---|---|---|\n");
   const auto line = [&](const char *what, const auto &f) {
     std::printf("| %s |", what);
     for (const auto &name : names)
