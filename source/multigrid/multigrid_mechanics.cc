@@ -998,6 +998,7 @@ namespace PeriDEAL
                 }
 #else
               (void)n_pairs;
+              (void)groups;
               for (unsigned int h = 0; h < H; ++h)
                 sweep_offset_scalar<dim>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0,
                                          n, B.offset.data(), h, B.coefficient.data(),
