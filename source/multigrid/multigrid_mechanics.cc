@@ -10,8 +10,19 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <limits>
+
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#  include <immintrin.h>
+#  define PERIDEAL_MULTIGRID_AVX512 1
+// GCC 12 reports its own _mm512_undefined_pd() pass-through operands of
+// inlined AVX-512 intrinsics as maybe-uninitialized (a false positive).
+#  if defined(__GNUC__) && !defined(__clang__)
+#    pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#  endif
+#endif
 
 namespace PeriDEAL
 {
@@ -23,6 +34,16 @@ namespace PeriDEAL
       seconds_since(const std::chrono::steady_clock::time_point &start)
       {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      }
+
+      // CPU time of the calling thread [s] (timing(): not inflated by the
+      // other processes on a shared machine as wall time is).
+      double
+      thread_cpu_seconds()
+      {
+        timespec t;
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+        return t.tv_sec + 1e-9 * t.tv_nsec;
       }
 
       // Orientation of (p, q, r): > 0 counter-clockwise.
@@ -42,6 +63,150 @@ namespace PeriDEAL
         for (unsigned int d = 0; d < dim; ++d)
           w[d] = field[dim * i + d];
         return w;
+      }
+
+      // Chunk size of the lattice sweep (box positions): the chunk's forces,
+      // positions and the reactions it reaches stay in L2.
+      constexpr unsigned int sweep_chunk = 512;
+
+#ifdef PERIDEAL_MULTIGRID_AVX512
+      // NO positive offsets hs[.] of the sweep over the groups of eight box
+      // positions c0 + 8 groups[.] (the chunk's groups with a live bit; c0 a
+      // multiple of 8), eight positions per iteration: bond (L, L + o) for
+      // every live bit; the force on L is accumulated in acc (stride C), its
+      // reaction on L + o in reaction (stride N). 1/|y| from vrsqrt14pd and
+      // two Newton steps (relative error ~1e-16). A bond with
+      // |y| - r > s0 r breaks (2.34): its bit is cleared, it exerts no force
+      // and is recorded in @p broken as (offset, position).
+      template <int dim, int NO>
+      inline void
+      sweep_offsets(const double                                  *p,
+                    double                                        *reaction,
+                    double                                        *acc,
+                    std::uint8_t                                  *live,
+                    const std::size_t                              n_bytes,
+                    const std::size_t                              N,
+                    const unsigned int                             C,
+                    const std::size_t                              c0,
+                    const std::uint8_t                            *groups,
+                    const unsigned int                             n_groups,
+                    const long                                    *o,
+                    const unsigned int                            *hs,
+                    const double                                  *k,
+                    const double                                  *r,
+                    const double                                   s0,
+                    std::vector<std::pair<unsigned int, long>>    &broken)
+      {
+        std::uint8_t *bits[NO];
+        __m512d       vk[NO], vr[NO];
+        for (int q = 0; q < NO; ++q)
+          {
+            bits[q] = live + hs[q] * n_bytes + c0 / 8;
+            vk[q]   = _mm512_set1_pd(k[hs[q]]);
+            vr[q]   = _mm512_set1_pd(r[hs[q]]);
+          }
+        const __m512d vs0 = _mm512_set1_pd(s0), one = _mm512_set1_pd(1.),
+                      half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
+        for (unsigned int gi = 0; gi < n_groups; ++gi)
+          {
+            const unsigned int v = 8 * groups[gi];
+            __mmask8           alive[NO], any = 0;
+            for (int q = 0; q < NO; ++q)
+              any |= alive[q] = bits[q][v / 8];
+            if (any == 0)
+              continue;
+            const std::size_t L = c0 + v;
+            __m512d           pi[dim], f[dim];
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                pi[d] = _mm512_loadu_pd(p + d * N + L);
+                f[d]  = _mm512_load_pd(acc + d * C + v);
+              }
+            for (int q = 0; q < NO; ++q)
+              {
+                if (alive[q] == 0)
+                  continue;
+                __m512d y[dim];
+                for (unsigned int d = 0; d < dim; ++d)
+                  y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
+                __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+                for (unsigned int d = 1; d < dim; ++d)
+                  l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+                l2          = _mm512_mask_blend_pd(alive[q], one, l2);
+                const __m512d h   = _mm512_mul_pd(half, l2);
+                __m512d       inv = _mm512_rsqrt14_pd(l2);
+                for (unsigned int it = 0; it < 2; ++it)
+                  inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_half));
+                const __m512d  dl  = _mm512_fmsub_pd(l2, inv, vr[q]);
+                const __mmask8 brk = _mm512_mask_cmp_pd_mask(alive[q], dl,
+                                                             _mm512_mul_pd(vs0, vr[q]), _CMP_GT_OQ);
+                const __m512d  scale =
+                  _mm512_maskz_mul_pd(alive[q] & ~brk, _mm512_mul_pd(vk[q], dl), inv);
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    double *rd = reaction + d * N + L + o[hs[q]];
+                    f[d]       = _mm512_fmadd_pd(scale, y[d], f[d]);
+                    _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
+                  }
+                if (brk)
+                  {
+                    bits[q][v / 8] = alive[q] & ~brk;
+                    for (unsigned int l = 0; l < 8; ++l)
+                      if ((brk >> l) & 1u)
+                        broken.emplace_back(hs[q], long(L + l));
+                  }
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              _mm512_store_pd(acc + d * C + v, f[d]);
+          }
+      }
+#endif
+
+      // The portable counterpart of sweep_offsets() for one offset h.
+      template <int dim>
+      inline void
+      sweep_offset_scalar(const double                               *p,
+                          double                                     *reaction,
+                          double                                     *acc,
+                          std::uint8_t                               *live,
+                          const std::size_t                           n_bytes,
+                          const std::size_t                           N,
+                          const unsigned int                          C,
+                          const std::size_t                           c0,
+                          const unsigned int                          n,
+                          const long                                 *o,
+                          const unsigned int                          h,
+                          const double                               *k,
+                          const double                               *r,
+                          const double                                s0,
+                          std::vector<std::pair<unsigned int, long>> &broken)
+      {
+        std::uint8_t *bits = live + h * n_bytes + c0 / 8;
+        for (unsigned int v = 0; v < n; ++v)
+          if ((bits[v / 8] >> (v % 8)) & 1u)
+            {
+              const std::size_t L = c0 + v;
+              double            y[dim], l2 = 0.;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  y[d] = p[d * N + L + o[h]] - p[d * N + L];
+                  l2 += y[d] * y[d];
+                }
+              const double l  = std::sqrt(l2);
+              const double dl = l - r[h];
+              if (dl > s0 * r[h])
+                {
+                  bits[v / 8] &= std::uint8_t(~(1u << (v % 8)));
+                  broken.emplace_back(h, long(L));
+                  continue;
+                }
+              const double scale = k[h] * dl / l;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  acc[d * C + v] += scale * y[d];
+                  reaction[d * N + L + o[h]] += scale * y[d];
+                }
+            }
       }
     } // namespace
 
@@ -173,6 +338,8 @@ namespace PeriDEAL
                                        std::numeric_limits<double>::infinity();
       setup_lattice(coarse, prm.coarse_dx);
       setup_lattice(fine, prm.fine_dx);
+      setup_box(coarse);
+      setup_box(fine);
       for (const unsigned int g : {0u, 1u})
         {
           const auto n = grids[g].n_nodes;
@@ -261,6 +428,171 @@ namespace PeriDEAL
 
     template <int dim>
     void
+    MechanicsSolver<dim>::setup_box(const Grid g)
+    {
+      const Lattice &L = grids[g];
+      Box           &B = boxes[g];
+      const int      R = L.radius;
+      B.n_box          = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          B.stride[d] = B.n_box;
+          B.n_box *= L.n[d] + 2 * R;
+        }
+      B.offset.clear();
+      B.k.clear();
+      B.coefficient.clear();
+      B.length.clear();
+      for (unsigned int k = 0; k < L.offset.size(); ++k)
+        {
+          long o = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            o += L.offset[k][d] * B.stride[d];
+          if (o <= 0)
+            continue;
+          B.offset.push_back(o);
+          B.k.push_back(k);
+          B.coefficient.push_back(L.coefficient[k]);
+          B.length.push_back(L.length[k]);
+        }
+      B.o_max   = B.offset.empty() ? 0 : *std::max_element(B.offset.begin(), B.offset.end());
+      B.n_bytes = (B.n_box + sweep_chunk - 1) / sweep_chunk * sweep_chunk / 8;
+      B.n_alloc = 8 * B.n_bytes + B.o_max + 16;
+      B.position.resize(L.n_nodes);
+      B.state.assign(B.n_alloc, 0);
+      B.reference.assign(dim * B.n_alloc, 0.);
+      // Reference positions relative to the lattice centre (small
+      // magnitudes: round-off of y = p_j - p_i ~ eps |x - x_c|).
+      std::array<int, dim> mid;
+      for (unsigned int d = 0; d < dim; ++d)
+        mid[d] = L.n[d] / 2;
+      for (unsigned int i = 0; i < L.n_nodes; ++i)
+        {
+          const auto ix = L.index(i);
+          long       P  = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            P += (ix[d] + R) * B.stride[d];
+          B.position[i] = P;
+          B.state[P]    = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            B.reference[d * B.n_alloc + P] = (ix[d] - mid[d]) * L.dx;
+        }
+      B.first = L.n_nodes > 0 ? B.position.front() : 0;
+      B.last  = L.n_nodes > 0 ? B.position.back() + 1 : 0;
+      B.p     = B.reference;
+      B.reaction.assign(dim * B.n_alloc, 0.);
+      B.valid = false;
+    }
+
+    template <int dim>
+    void
+    MechanicsSolver<dim>::build_box_bits(const Grid g)
+    {
+      const Lattice     &L = grids[g];
+      Box               &B = boxes[g];
+      const unsigned int S = L.offset.size(), H = B.offset.size();
+      const std::size_t  W = B.n_bytes / 8;
+      if (!B.intact_valid)
+        {
+          // From the broken flags (after set-up and pre-cracks; bonds
+          // broken by the sweep clear their bit there).
+          B.intact.assign(H * W, 0);
+          for (unsigned int i = 0; i < L.n_nodes; ++i)
+            {
+              const bool in = L.interior(i);
+              const auto ix = L.index(i);
+              const long P  = B.position[i];
+              for (unsigned int h = 0; h < H; ++h)
+                {
+                  const unsigned int k = B.k[h];
+                  if (broken[g][std::size_t(i) * S + k])
+                    continue;
+                  if (!in)
+                    {
+                      auto jx = ix;
+                      for (unsigned int d = 0; d < dim; ++d)
+                        jx[d] += L.offset[k][d];
+                      if (!L.inside(jx))
+                        continue;
+                    }
+                  B.intact[h * W + P / 64] |= std::uint64_t(1) << (P % 64);
+                }
+            }
+          B.intact_valid = true;
+        }
+      B.evaluated.clear();
+      B.evaluated_position.clear();
+      B.evaluated_bits.assign(W + B.o_max / 64 + 2, 0);
+      for (const unsigned int i : active[g])
+        if (evaluated(g, i))
+          {
+            const long P = B.position[i];
+            B.evaluated.push_back(i);
+            B.evaluated_position.push_back(P);
+            B.evaluated_bits[P / 64] |= std::uint64_t(1) << (P % 64);
+          }
+      for (unsigned int i = 0; i < L.n_nodes; ++i)
+        B.state[B.position[i]] = 1 + active_flag[g][i];
+      // live = intact & (evaluated(P) | evaluated(P + o)), 64 positions at
+      // a time: bit P of the evaluated bits shifted by o is bit P + o.
+      B.live.resize(H * W);
+      const std::uint64_t *E = B.evaluated_bits.data();
+      for (unsigned int h = 0; h < H; ++h)
+        {
+          const std::size_t   q = B.offset[h] / 64;
+          const unsigned int  r = B.offset[h] % 64;
+          const std::uint64_t *I = B.intact.data() + h * W;
+          std::uint64_t       *Z = B.live.data() + h * W;
+          for (std::size_t w = 0; w < W; ++w)
+            {
+              const std::uint64_t shifted =
+                r == 0 ? E[w + q] : (E[w + q] >> r) | (E[w + q + 1] << (64 - r));
+              Z[w] = I[w] & (E[w] | shifted);
+            }
+        }
+      // Groups of eight positions with a live bit for some offset, per
+      // chunk (the sweep visits only these).
+      std::vector<std::uint64_t> any(W, 0);
+      for (unsigned int h = 0; h < H; ++h)
+        for (std::size_t w = 0; w < W; ++w)
+          any[w] |= B.live[h * W + w];
+      const unsigned int groups_per_chunk = sweep_chunk / 8;
+      B.group_start.assign(1, 0);
+      B.groups.clear();
+      for (std::size_t c = 0; c < W * 64 / sweep_chunk; ++c)
+        {
+          for (unsigned int gi = 0; gi < groups_per_chunk; ++gi)
+            {
+              const std::size_t byte = c * groups_per_chunk + gi;
+              if ((any[byte / 8] >> (8 * (byte % 8))) & 0xFFu)
+                B.groups.push_back(gi);
+            }
+          B.group_start.push_back(B.groups.size());
+        }
+      B.valid = true;
+    }
+
+    template <int dim>
+    void
+    MechanicsSolver<dim>::fill_box_positions(const Grid g)
+    {
+      Box &B = boxes[g];
+      if (B.filled == u_version)
+        return;
+      B.filled          = u_version;
+      const std::size_t N = B.n_alloc;
+      const auto       &U = u[g];
+      for (const auto *list : {&active[g], &fictitious[g]})
+        for (const unsigned int i : *list)
+          {
+            const long P = B.position[i];
+            for (unsigned int d = 0; d < dim; ++d)
+              B.p[d * N + P] = B.reference[d * N + P] + U[dim * i + d];
+          }
+    }
+
+    template <int dim>
+    void
     MechanicsSolver<dim>::setup_wls()
     {
       // The coarse lattice is uniform, so every coarse node whose family is
@@ -268,11 +600,15 @@ namespace PeriDEAL
       // patch (the family of its centre = the bond stencil).
       const Lattice          &L = grids[coarse];
       std::vector<Point<dim>> position(1);
-      std::vector<long>       lin(1, 0);
+      std::vector<long>       lin(1, 0), box(1, 0);
       for (unsigned int k = 0; k < L.offset.size(); ++k)
         {
           position.emplace_back(Point<dim>() + L.xi[k]);
           lin.push_back(L.linear_offset[k]);
+          long o = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            o += L.offset[k][d] * boxes[coarse].stride[d];
+          box.push_back(o);
         }
       std::vector<std::uint64_t> family_start(position.size() + 1, L.offset.size());
       family_start[0] = 0;
@@ -285,10 +621,12 @@ namespace PeriDEAL
       WlsQuadrature<dim> wls(wp, c, prm.omega, prm.delta);
       wls.build(position, family_start, family, {0u});
       wls_offset.clear();
+      wls_box_offset.clear();
       wls_weight.clear();
       for (auto b = wls.row_start[0]; b < wls.row_start[1]; ++b)
         {
           wls_offset.push_back(lin[wls.col[b]]);
+          wls_box_offset.push_back(box[wls.col[b]]);
           for (unsigned int e = 0; e < dim * dim; ++e)
             wls_weight.push_back(wls.weight[b * dim * dim + e]);
         }
@@ -408,6 +746,7 @@ namespace PeriDEAL
           active_flag[g].assign(grids[g].n_nodes, 0);
           active[g].clear();
           fictitious[g].clear();
+          boxes[g].valid = false;
         }
       for (unsigned int i = 0; i < C.n_nodes; ++i)
         if (!refined[i])
@@ -449,33 +788,76 @@ namespace PeriDEAL
             fictitious[coarse].push_back(i);
       if (!active[fine].empty() && !active[coarse].empty())
         {
-          // Only fine nodes of unrefined cells near a refined cell can be
-          // fictitious: dilate the refined cells by the stencil reach.
-          const int Rc = static_cast<int>(std::ceil((F.radius * F.dx) / C.dx)) + 1;
-          std::vector<std::uint8_t> near(C.n_nodes, 0);
+          // Only fine nodes of unrefined cells with a refined cell in reach
+          // of their stencil can be fictitious: count the refined cells in
+          // the box of coarse cells the stencil touches by a summed-area
+          // table (O(2^dim) per node), then search the stencil.
+          std::array<int, dim> m;
+          std::size_t          n_table = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              m[d] = C.n[d] + 1;
+              n_table *= m[d];
+            }
+          const auto table_index = [&](const std::array<int, dim> &t) {
+            std::size_t k = 0;
+            for (int d = dim - 1; d >= 0; --d)
+              k = k * m[d] + t[d];
+            return k;
+          };
+          std::vector<unsigned int> table(n_table, 0);
           for (unsigned int i = 0; i < C.n_nodes; ++i)
             if (refined[i])
               {
-                const auto           ix = C.index(i);
-                std::array<int, dim> jx, o;
-                const auto           visit = [&](auto &&self, const unsigned int d) -> void {
-                  if (d == dim)
-                    {
-                      for (unsigned int e = 0; e < dim; ++e)
-                        jx[e] = ix[e] + o[e];
-                      if (C.inside(jx))
-                        near[C.node(jx)] = 1;
-                      return;
-                    }
-                  for (o[d] = -Rc; o[d] <= Rc; ++o[d])
-                    self(self, d + 1);
-                };
-                visit(visit, 0);
+                auto t = C.index(i);
+                for (unsigned int d = 0; d < dim; ++d)
+                  ++t[d];
+                table[table_index(t)] = 1;
               }
+          for (unsigned int d = 0; d < dim; ++d)
+            for (std::size_t k = 0; k < n_table; ++k)
+              {
+                std::array<int, dim> t;
+                std::size_t          rest = k;
+                for (unsigned int e = 0; e < dim; ++e)
+                  {
+                    t[e] = rest % m[e];
+                    rest /= m[e];
+                  }
+                if (t[d] == 0)
+                  continue;
+                auto s = t;
+                --s[d];
+                table[k] += table[table_index(s)];
+              }
+          const int R = F.radius;
           for (unsigned int f = 0; f < F.n_nodes; ++f)
             {
               const unsigned int cell = cell_of(f);
-              if (!refined[cell] && near[cell] && has_active_neighbour(fine, f))
+              if (refined[cell])
+                continue;
+              const auto           fx = F.index(f);
+              std::array<int, dim> lo, hi;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  lo[d] = std::max(fx[d] - R, 0) / int(ratio);
+                  hi[d] = std::min(fx[d] + R, F.n[d] - 1) / int(ratio) + 1;
+                }
+              // Inclusion-exclusion over the 2^dim corners of [lo, hi).
+              long count = 0;
+              for (unsigned int corner = 0; corner < (1u << dim); ++corner)
+                {
+                  std::array<int, dim> t;
+                  int                  sign = 1;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      const bool up = corner & (1u << d);
+                      t[d]          = up ? hi[d] : lo[d];
+                      sign *= up ? 1 : -1;
+                    }
+                  count += sign * long(table[table_index(t)]);
+                }
+              if (count > 0 && has_active_neighbour(fine, f))
                 fictitious[fine].push_back(f);
             }
         }
@@ -550,52 +932,107 @@ namespace PeriDEAL
     void
     MechanicsSolver<dim>::standard_forces(const Grid g, const bool allow_breaking)
     {
-      const Lattice      &L = grids[g];
-      const unsigned int  S = L.offset.size();
+      Box &B = boxes[g];
+      if (!B.valid)
+        build_box_bits(g);
+      if (B.evaluated.empty())
+        return;
+      fill_box_positions(g);
+      const Lattice      &Lt      = grids[g];
+      const unsigned int  S       = Lt.offset.size();
+      const std::size_t   N       = B.n_alloc;
       const double        inv_rho = 1. / prm.density;
-      std::vector<double> &U = u[g], &A = a[g];
-      auto               &B = broken[g];
-      const bool          skip_wls = g == coarse && !use_wls.empty();
-      for (const unsigned int i : active[g])
+      // Coarse bonds break only in the uniform coarse model (see
+      // compute_accelerations()): an infinite s0 never breaks.
+      const double        s_break = allow_breaking ? s0 : std::numeric_limits<double>::infinity();
+      constexpr unsigned int C = sweep_chunk;
+      alignas(64) double     acc[dim * C];
+      double                *R      = B.reaction.data();
+      const std::size_t      n_bits = 8 * B.n_bytes;
+      const unsigned int     H = B.offset.size(), n_pairs = H / 2;
+      // Reactions are written from the first chunk with work on: zero
+      // from there (zero_begin) up to what the chunks reach (zeroed).
+      std::size_t            zero_begin = 0, zeroed = 0, e = 0;
+      bool                   started = false;
+      const std::size_t      E      = B.evaluated.size();
+      auto                  &A      = a[g];
+      B.newly_broken.clear();
+      // Byte view of the live words (little endian: bit P % 8 of byte P / 8).
+      static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "bit layout of the live words");
+      std::uint8_t *live = reinterpret_cast<std::uint8_t *>(B.live.data());
+      for (std::size_t c0 = 0; c0 < n_bits && e < E; c0 += C)
         {
-          if (skip_wls && use_wls[i])
-            continue;
-          const bool in = L.interior(i);
-          const auto ix = L.index(i);
-          double     f[dim] = {};
-          for (unsigned int k = 0; k < S; ++k)
+          const unsigned int n    = std::min<std::size_t>(C, n_bits - c0);
+          const std::uint8_t *groups   = B.groups.data() + B.group_start[c0 / C];
+          const unsigned int  n_groups = B.group_start[c0 / C + 1] - B.group_start[c0 / C];
+          const bool          work     = n_groups > 0;
+          if (work)
             {
-              if (B[std::size_t(i) * S + k])
-                continue;
-              if (!in)
+              if (!started)
                 {
-                  auto jx = ix;
-                  for (unsigned int d = 0; d < dim; ++d)
-                    jx[d] += L.offset[k][d];
-                  if (!L.inside(jx))
-                    continue;
+                  zero_begin = zeroed = c0;
+                  started             = true;
                 }
-              const unsigned int j = i + L.linear_offset[k];
-              double             y[dim], y2 = 0.;
+              const std::size_t need = std::min<std::size_t>(N, c0 + n + B.o_max + 8);
               for (unsigned int d = 0; d < dim; ++d)
+                std::fill(R + d * N + zeroed, R + d * N + std::max(zeroed, need), 0.);
+              zeroed = std::max(zeroed, need);
+              std::fill(acc, acc + dim * C, 0.);
+#ifdef PERIDEAL_MULTIGRID_AVX512
+              // Two offsets per pass (shared loads of p_L and of the force).
+              for (unsigned int h = 0; h < n_pairs; ++h)
                 {
-                  y[d] = L.xi[k][d] + U[dim * j + d] - U[dim * i + d];
-                  y2 += y[d] * y[d];
+                  const unsigned int hs[2] = {h, h + n_pairs};
+                  sweep_offsets<dim, 2>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
+                                        n_groups,
+                                        B.offset.data(), hs, B.coefficient.data(),
+                                        B.length.data(), s_break, B.newly_broken);
                 }
-              const double len = std::sqrt(y2);
-              const double ext = len - L.length[k];
-              if (allow_breaking && ext > s0 * L.length[k])
+              if (H % 2)
                 {
-                  B[std::size_t(i) * S + k]           = 1;
-                  B[std::size_t(j) * S + L.mirror[k]] = 1;
-                  continue;
+                  const unsigned int hs[1] = {H - 1};
+                  sweep_offsets<dim, 1>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
+                                        n_groups,
+                                        B.offset.data(), hs, B.coefficient.data(),
+                                        B.length.data(), s_break, B.newly_broken);
                 }
-              const double s = L.coefficient[k] * ext / len;
-              for (unsigned int d = 0; d < dim; ++d)
-                f[d] += s * y[d];
+#else
+              (void)n_pairs;
+              (void)groups;
+              for (unsigned int h = 0; h < H; ++h)
+                sweep_offset_scalar<dim>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0,
+                                         n, B.offset.data(), h, B.coefficient.data(),
+                                         B.length.data(), s_break, B.newly_broken);
+#endif
             }
-          for (unsigned int d = 0; d < dim; ++d)
-            A[dim * i + d] = f[d] * inv_rho;
+          // F = (forces on L) - (reactions on L): final once L's chunk is
+          // done, reactions coming from lower positions only.
+          for (; e < E && std::size_t(B.evaluated_position[e]) < c0 + n; ++e)
+            {
+              const std::size_t P = B.evaluated_position[e];
+              const unsigned int i = B.evaluated[e];
+              for (unsigned int d = 0; d < dim; ++d)
+                A[dim * i + d] =
+                  ((work ? acc[d * C + P - c0] : 0.) -
+                   (P >= zero_begin && P < zeroed ? R[d * N + P] : 0.)) *
+                  inv_rho;
+            }
+        }
+      // Both copies of the newly broken bonds (rare).
+      for (const auto &[h, P] : B.newly_broken)
+        {
+          std::array<int, dim> ix;
+          long                 rest = P;
+          for (int d = dim - 1; d >= 0; --d)
+            {
+              ix[d] = int(rest / B.stride[d]) - Lt.radius;
+              rest %= B.stride[d];
+            }
+          const unsigned int i = Lt.node(ix), k = B.k[h];
+          const unsigned int j = i + Lt.linear_offset[k];
+          broken[g][std::size_t(i) * S + k]           = 1;
+          broken[g][std::size_t(j) * S + Lt.mirror[k]] = 1;
+          B.intact[h * (B.n_bytes / 8) + P / 64] &= ~(std::uint64_t(1) << (P % 64));
         }
     }
 
@@ -603,62 +1040,105 @@ namespace PeriDEAL
     void
     MechanicsSolver<dim>::wls_forces()
     {
-      const unsigned int n       = wls_offset.size();
-      const double       inv_rho = 1. / prm.density;
-      const auto        &U       = u[coarse];
-      auto              &A       = a[coarse];
+      // Over the coarse box positions from the first to the last WLS
+      // node, one stencil offset at a time (contiguous, vectorized); nodes
+      // that are not active WLS nodes get values that are not used.
+      Box              &B = boxes[coarse];
+      const std::size_t N = B.n_alloc;
+      long              lo = std::numeric_limits<long>::max(), hi = 0;
       for (const unsigned int i : active[coarse])
         if (use_wls[i])
           {
-            double f[dim] = {};
-            for (unsigned int k = 0; k < n; ++k)
-              {
-                const double *w  = &wls_weight[k * dim * dim];
-                const double *uj = &U[dim * (i + wls_offset[k])];
-                for (unsigned int d = 0; d < dim; ++d)
-                  for (unsigned int e = 0; e < dim; ++e)
-                    f[d] += w[d * dim + e] * uj[e];
-              }
-            for (unsigned int d = 0; d < dim; ++d)
-              A[dim * i + d] = f[d] * inv_rho;
+            lo = std::min(lo, B.position[i]);
+            hi = std::max(hi, B.position[i] + 1);
           }
+      if (hi <= lo)
+        return;
+      if (wls_u.size() != dim * N)
+        {
+          wls_u.assign(dim * N, 0.);
+          wls_f.assign(dim * N, 0.);
+        }
+      const auto &U = u[coarse];
+      for (const auto *list : {&active[coarse], &fictitious[coarse]})
+        for (const unsigned int i : *list)
+          for (unsigned int d = 0; d < dim; ++d)
+            wls_u[d * N + B.position[i]] = U[dim * i + d];
+      // Chunks of positions (the chunk's forces in L1), all offsets per chunk.
+      constexpr std::size_t C = 256;
+      alignas(64) double    f[dim][C];
+      for (std::size_t c0 = lo; c0 < std::size_t(hi); c0 += C)
+        {
+          const std::size_t n = std::min<std::size_t>(C, hi - c0);
+          for (unsigned int d = 0; d < dim; ++d)
+            std::fill(f[d], f[d] + n, 0.);
+          for (unsigned int k = 0; k < wls_box_offset.size(); ++k)
+            {
+              const double *w = &wls_weight[k * dim * dim];
+              for (unsigned int e2 = 0; e2 < dim; ++e2)
+                {
+                  const double *__restrict us = wls_u.data() + e2 * N + c0 + wls_box_offset[k];
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      const double         we = w[d * dim + e2];
+                      double *__restrict fd = f[d];
+#pragma omp simd
+                      for (std::size_t q = 0; q < n; ++q)
+                        fd[q] += we * us[q];
+                    }
+                }
+            }
+          for (unsigned int d = 0; d < dim; ++d)
+            std::copy(f[d], f[d] + n, wls_f.begin() + d * N + c0);
+        }
+      const double inv_rho = 1. / prm.density;
+      auto        &A       = a[coarse];
+      for (const unsigned int i : active[coarse])
+        if (use_wls[i])
+          for (unsigned int d = 0; d < dim; ++d)
+            A[dim * i + d] = wls_f[d * N + B.position[i]] * inv_rho;
     }
 
     template <int dim>
     void
     MechanicsSolver<dim>::compute_accelerations()
     {
-      auto start = std::chrono::steady_clock::now();
+      ++u_version;
+      double start = thread_cpu_seconds();
       std::vector<double> *fields[2] = {&u[coarse], &u[fine]};
       interpolate_fictitious(fields);
-      timing[1] += seconds_since(start);
-      start = std::chrono::steady_clock::now();
+      timing[1] += thread_cpu_seconds() - start;
+      start = thread_cpu_seconds();
       standard_forces(fine, true);
       // Coarse bonds break only in the uniform coarse model: in the
       // adaptive ones their cells are refined before they reach s0.
       standard_forces(coarse, prm.model == MechanicsModel::uniform_coarse);
       if (!use_wls.empty())
         wls_forces();
-      timing[0] += seconds_since(start);
+      timing[0] += thread_cpu_seconds() - start;
     }
 
     // ------------------------------------------------------------------ switching
 
     template <int dim>
     bool
-    MechanicsSolver<dim>::find_critical(std::vector<std::uint8_t> &zone) const
+    MechanicsSolver<dim>::find_critical(std::vector<std::uint8_t> &zone)
     {
       const Lattice     &L = grids[coarse];
-      const unsigned int S = L.offset.size();
-      const auto        &U = u[coarse];
+      Box               &B = boxes[coarse];
+      const std::size_t  N = B.n_alloc;
       const double       threshold = prm.switching_sigma * s0;
-      bool               any       = false;
-      zone.assign(L.n_nodes, 0);
+      zone.clear();
+      if (active[coarse].empty())
+        return false;
+      if (!B.valid)
+        build_box_bits(coarse);
+      fill_box_positions(coarse);
       // H(x): the node and its neighbours within delta.
       const auto mark_family = [&](const unsigned int i) {
         zone[i]       = 1;
         const auto ix = L.index(i);
-        for (unsigned int k = 0; k < S; ++k)
+        for (unsigned int k = 0; k < L.offset.size(); ++k)
           {
             if (L.length[k] > prm.delta * (1. + 1e-12))
               continue;
@@ -669,34 +1149,53 @@ namespace PeriDEAL
               zone[L.node(jx)] = 1;
           }
       };
-      for (const unsigned int i : active[coarse])
+      const auto node_at = [&](const long P) {
+        std::array<int, dim> ix;
+        long                 rest = P;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            ix[d] = int(rest / B.stride[d]) - L.radius;
+            rest %= B.stride[d];
+          }
+        return L.node(ix);
+      };
+      // (3.80) for every bond (once, as (P, P + o), o > 0) with both ends
+      // in the lattice and an active end, broken or not: |y| - r >= sigma
+      // s0 r, i.e. |y|^2 >= ((1 + sigma s0) r)^2. A branch-free pass per
+      // offset (vectorized) finds whether any bond is critical; only then a
+      // second pass finds which.
+      const std::uint8_t *state = B.state.data();
+      const double       *p     = B.p.data();
+      bool                any   = false;
+      for (unsigned int h = 0; h < B.offset.size(); ++h)
         {
-          const bool in = L.interior(i);
-          const auto ix = L.index(i);
-          for (unsigned int k = 0; k < S; ++k)
-            {
-              if (!in)
-                {
-                  auto jx = ix;
-                  for (unsigned int d = 0; d < dim; ++d)
-                    jx[d] += L.offset[k][d];
-                  if (!L.inside(jx))
-                    continue;
-                }
-              const unsigned int j  = i + L.linear_offset[k];
-              double             y2 = 0.;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  const double y = L.xi[k][d] + U[dim * j + d] - U[dim * i + d];
-                  y2 += y * y;
-                }
-              if (std::sqrt(y2) - L.length[k] >= threshold * L.length[k])
-                {
-                  mark_family(i);
-                  mark_family(j);
-                  any = true;
-                }
-            }
+          const long   o     = B.offset[h];
+          const double bound = (1. + threshold) * B.length[h];
+          const double lim   = bound * bound;
+          const auto   critical = [&](const long P) {
+            double y2 = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double y = p[d * N + P + o] - p[d * N + P];
+                y2 += y * y;
+              }
+            return (y2 >= lim) & (state[P] + state[P + o] >= 3);
+          };
+          int hit = 0;
+#pragma omp simd reduction(| : hit)
+          for (long P = B.first; P < B.last; ++P)
+            hit |= critical(P);
+          if (!hit)
+            continue;
+          if (!any)
+            zone.assign(L.n_nodes, 0);
+          any = true;
+          for (long P = B.first; P < B.last; ++P)
+            if (critical(P))
+              {
+                mark_family(node_at(P));
+                mark_family(node_at(P + o));
+              }
         }
       return any;
     }
@@ -706,11 +1205,33 @@ namespace PeriDEAL
     MechanicsSolver<dim>::refine(const std::vector<std::uint8_t> &zone)
     {
       const Lattice &C = grids[coarse], &F = grids[fine];
-      // Current values of the inactive coarse nodes (sources of the new
-      // fine nodes) from the fine nodes around them.
+      // Current values of the inactive coarse nodes that are sources of
+      // the new fine nodes (the corners of the coarse lattice cells holding
+      // them: within one coarse cell of the zone) from the fine nodes
+      // around them.
+      std::vector<std::uint8_t> source(C.n_nodes, 0);
+      for (unsigned int i = 0; i < C.n_nodes; ++i)
+        if (zone[i] && !refined[i])
+          {
+            const auto           ix = C.index(i);
+            std::array<int, dim> jx, o;
+            const auto           visit = [&](auto &&self, const unsigned int d) -> void {
+              if (d == dim)
+                {
+                  for (unsigned int e = 0; e < dim; ++e)
+                    jx[e] = ix[e] + o[e];
+                  if (C.inside(jx))
+                    source[C.node(jx)] = 1;
+                  return;
+                }
+              for (o[d] = -1; o[d] <= 1; ++o[d])
+                self(self, d + 1);
+            };
+            visit(visit, 0);
+          }
       std::vector<std::pair<unsigned int, double>> src;
       for (unsigned int i = 0; i < C.n_nodes; ++i)
-        if (refined[i])
+        if (refined[i] && source[i])
           {
             interpolation_sources(fine, C.point(i), src);
             for (auto *field : {&u, &v, &a})
@@ -772,8 +1293,13 @@ namespace PeriDEAL
                   }
             refined[i] = 1;
           }
+      ++u_version;
       if (n_new > 0)
-        update_node_sets();
+        {
+          update_node_sets();
+          for (const Grid g : {coarse, fine})
+            build_box_bits(g);
+        }
       return n_new;
     }
 
@@ -835,16 +1361,16 @@ namespace PeriDEAL
       if (prm.model == MechanicsModel::adaptive_standard ||
           prm.model == MechanicsModel::adaptive_hybrid)
         {
-          auto                      start = std::chrono::steady_clock::now();
+          double                    start = thread_cpu_seconds();
           std::vector<std::uint8_t> zone;
           const bool                critical = find_critical(zone);
-          timing[2] += seconds_since(start);
+          timing[2] += thread_cpu_seconds() - start;
           if (critical)
             {
-              start = std::chrono::steady_clock::now();
+              start = thread_cpu_seconds();
               if (refine(zone) > 0)
                 ++switches;
-              timing[3] += seconds_since(start);
+              timing[3] += thread_cpu_seconds() - start;
             }
         }
     }
@@ -861,10 +1387,19 @@ namespace PeriDEAL
         {
           const Lattice     &L = grids[g];
           const unsigned int S = L.offset.size();
+          // A bond crossing the segment has its end within the bond
+          // length (at most radius dx) of the segment's bounding box.
+          const double reach = L.radius * L.dx;
           for (unsigned int i = 0; i < L.n_nodes; ++i)
             {
               const auto       ix = L.index(i);
               const Point<dim> xi = L.point(i);
+              bool             near = true;
+              for (unsigned int d = 0; d < dim; ++d)
+                near = near && xi[d] >= std::min(p[d], q[d]) - reach &&
+                       xi[d] <= std::max(p[d], q[d]) + reach;
+              if (!near)
+                continue;
               for (unsigned int k = 0; k < S; ++k)
                 {
                   auto jx = ix;
@@ -878,6 +1413,8 @@ namespace PeriDEAL
                     broken[g][std::size_t(i) * S + k] = 1;
                 }
             }
+          boxes[g].valid        = false;
+          boxes[g].intact_valid = false;
         }
     }
 
@@ -1185,8 +1722,10 @@ namespace PeriDEAL
         monitor(s);
       for (unsigned int k = 1; k <= r.steps; ++k)
         {
-          const auto start = std::chrono::steady_clock::now();
+          const auto   start = std::chrono::steady_clock::now();
+          const double cpu   = thread_cpu_seconds();
           s.advance();
+          r.cpu_seconds += thread_cpu_seconds() - cpu;
           r.seconds += seconds_since(start);
           if (monitor && ((interval > 0 && k % interval == 0) || k == r.steps))
             monitor(s);

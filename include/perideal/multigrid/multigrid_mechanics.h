@@ -243,7 +243,7 @@ namespace PeriDEAL
       {
         return switches;
       }
-      /** Wall time spent in forces, interpolation, switching test, switching [s]. */
+      /** Thread CPU time spent in forces, interpolation, switching test, switching [s]. */
       std::array<double, 4> timing{{0., 0., 0., 0.}};
       double
       micromodulus() const
@@ -313,11 +313,67 @@ namespace PeriDEAL
         interior(const unsigned int i) const;
       };
 
+      /**
+       * A grid's bonds as a lattice sweep (the idea of BondBasedOperator's
+       * sweep): the lattice padded by the stencil radius on every side, so
+       * that a bond is a fixed offset o > 0 between box positions (L, L + o)
+       * and each bond is evaluated once (Newton's third law: the force on L,
+       * its reaction on L + o). Per positive offset a bit per box position
+       * says the bond is to be evaluated: unbroken, both ends in the lattice
+       * and at least one end "evaluated" (an active node whose force the
+       * grid's standard scheme gives). The other end is active or
+       * fictitious; reactions on fictitious (or WLS) nodes are discarded.
+       */
+      struct Box
+      {
+        std::array<long, dim> stride{};
+        long                  n_box = 0, o_max = 0;
+        std::size_t           n_bytes = 0, n_alloc = 0;
+        /** Positive stencil offsets: box offset, stencil index k, coefficient, length. */
+        std::vector<long>         offset;
+        std::vector<unsigned int> k;
+        std::vector<double>       coefficient, length;
+        /** Box position of node i. */
+        std::vector<long> position;
+        /**
+         * Per positive offset (n_bytes each, as 64-bit words): intact bits
+         * (both ends in the lattice, bond unbroken) and live bits (intact
+         * and an evaluated end); per chunk the groups of 8 positions with
+         * a live bit (CSR: group_start per chunk, groups within the chunk).
+         */
+        std::vector<std::uint64_t> intact, live;
+        std::vector<unsigned int>  group_start;
+        std::vector<std::uint8_t>  groups;
+        /** Evaluated nodes as bits per box position (padded for shifted reads). */
+        std::vector<std::uint64_t> evaluated_bits;
+        bool                       intact_valid = false;
+        /** The evaluated nodes (ascending) and their box positions. */
+        std::vector<unsigned int> evaluated;
+        std::vector<long>         evaluated_position;
+        /** x - x_c + u and reactions per box position, dim arrays of n_alloc. */
+        std::vector<double> p, reaction;
+        /** Scratch: (offset, position) of bonds broken in this sweep. */
+        std::vector<std::pair<unsigned int, long>> newly_broken;
+        /** x - x_c per box position (dim arrays of n_alloc). */
+        std::vector<double> reference;
+        /** Per box position: 0 outside the lattice, 1 inactive node, 2 active node. */
+        std::vector<std::uint8_t> state;
+        /** Box positions of the first and one past the last node. */
+        long first = 0, last = 0;
+        /** u_version when p was filled. */
+        std::uint64_t filled = 0;
+        /** False when the active set or the broken flags changed since the bits were built. */
+        bool valid = false;
+      };
+
       MechanicsParameters<dim> prm;
       unsigned int             ratio;
       double                   c, s0, dt = 0., t = 0.;
       unsigned int             n_step = 0, switches = 0;
       std::array<Lattice, 2>   grids;
+      std::array<Box, 2>       boxes;
+      /** Incremented whenever u of some node may have changed (box positions stale). */
+      std::uint64_t            u_version = 1;
       /** Interleaved u, v, a per grid. */
       std::array<std::vector<double>, 2> u, v, a;
       std::array<std::vector<std::uint8_t>, 2> active_flag, broken;
@@ -341,6 +397,18 @@ namespace PeriDEAL
 
       void
       setup_lattice(const Grid g, const double dx);
+      /** Box geometry and positive offsets of grid g (after setup_lattice). */
+      void
+      setup_box(const Grid g);
+      /** Live bits of grid g from the broken flags and the evaluated nodes. */
+      void
+      build_box_bits(const Grid g);
+      /** True if grid g's standard scheme gives node i's force. */
+      bool
+      evaluated(const Grid g, const unsigned int i) const
+      {
+        return active_flag[g][i] && !(g == coarse && !use_wls.empty() && use_wls[i]);
+      }
       void
       setup_wls();
       /** Rebuild active/fictitious lists and interpolation rows from @p refined. */
@@ -366,7 +434,13 @@ namespace PeriDEAL
       refine(const std::vector<std::uint8_t> &zone);
       /** Coarse cells to refine after the step (3.80); empty result if none. */
       bool
-      find_critical(std::vector<std::uint8_t> &zone) const;
+      find_critical(std::vector<std::uint8_t> &zone);
+      /** p = x - x_c + u in grid g's box for its active and fictitious nodes. */
+      void
+      fill_box_positions(const Grid g);
+      /** WLS displacements per coarse box position and the forces (hybrid). */
+      std::vector<double> wls_u, wls_f;
+      std::vector<long>   wls_box_offset;
       void
       apply_prescribed();
     };
@@ -416,7 +490,9 @@ namespace PeriDEAL
         double       angle = 0., length = 0.;
         /** Wall time of the time loop (setup excluded) [s]. */
         double seconds = 0.;
-        /** MechanicsSolver::timing: forces, interpolation, switching test, switching. */
+        /** Thread CPU time of the time loop (setup excluded) [s]. */
+        double cpu_seconds = 0.;
+        /** MechanicsSolver::timing (CPU): forces, interpolation, switching test, switching. */
         std::array<double, 4> timing{{0., 0., 0., 0.}};
       };
       /**
