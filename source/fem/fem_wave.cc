@@ -1,6 +1,7 @@
 #include <deal.II/base/quadrature_lib.h>
 
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_q1.h>
 
 #include <deal.II/grid/grid_tools.h>
 
@@ -472,10 +473,13 @@ namespace PeriDEAL
       double value = 0., found = 0.;
       try
         {
-          const auto cell = GridTools::find_active_cell_around_point(dof_handler, p);
-          if (cell->is_locally_owned())
+          const auto [cell, ref] = GridTools::find_active_cell_around_point(MappingQ1<dim>(), dof_handler, p);
+          if (cell.state() == IteratorState::valid && cell->is_locally_owned())
             {
-              value = VectorTools::point_value(dof_handler, u, p);
+              std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+              cell->get_dof_indices(dofs);
+              for (unsigned int i = 0; i < dofs.size(); ++i)
+                value += u(dofs[i]) * fe.shape_value(i, ref);
               found = 1.;
             }
         }
