@@ -359,6 +359,27 @@ namespace
     check(throws(2, Fem::WaveBoundary::absorbing), "Q2 + EBF rejected naming FEM/Degree");
     check(!throws(2, Fem::WaveBoundary::first_order), "Q2 + first-order ABC accepted");
     check(throws(3, Fem::WaveBoundary::dirichlet), "Q3 rejected naming FEM/Degree");
+    // Consistent mass needs the implicit scheme; unknown schemes are named.
+    const auto rejects = [](const std::string &scheme, const bool lumped, const std::string &parameter) {
+      E13 c             = e13_default();
+      c.fem.time_step   = 0.01;
+      c.fem.scheme      = scheme;
+      c.fem.lumped_mass = lumped;
+      const ScalarFunctionFromFunctionObject<2> u0(pulse);
+      Triangulation<2>                          tria;
+      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
+      try
+        {
+          Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::dirichlet, c.abc, u0);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(parameter) != std::string::npos;
+        }
+      return false;
+    };
+    check(rejects("velocity Verlet", false, "FEM/Lumped mass"), "consistent mass + Verlet rejected naming FEM/Lumped mass");
+    check(rejects("leapfrog", true, "Time stepping/Scheme"), "unknown scheme rejected naming Time stepping/Scheme");
   }
 } // namespace
 
