@@ -1,13 +1,7 @@
 #include <deal.II/base/quadrature_lib.h>
 
-#include <deal.II/dofs/dof_tools.h>
-
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/fe/mapping_q1.h>
 
-#include <deal.II/lac/dynamic_sparsity_pattern.h>
-
-#include <deal.II/numerics/matrix_creator.h>
 #include <deal.II/numerics/vector_tools.h>
 
 #include <perideal/base/exceptions.h>
@@ -42,72 +36,28 @@ namespace PeriDEAL
     {
       dof_handler.reinit(tria);
       dof_handler.distribute_dofs(fe);
-      DynamicSparsityPattern dsp(dof_handler.n_dofs());
-      DoFTools::make_sparsity_pattern(dof_handler, dsp);
-      sparsity.copy_from(dsp);
-      mass.reinit(sparsity);
-      stiffness.reinit(sparsity);
-      system.reinit(sparsity);
-      const QGauss<dim> quadrature(fe.degree + 1);
-      MatrixCreator::create_mass_matrix(dof_handler, quadrature, mass);
-      MatrixCreator::create_laplace_matrix(dof_handler, quadrature, stiffness);
+      const bool absorbing = boundary == Abc::TruncationBoundary::absorbing;
+      near_field.reinit(dof_handler, absorbing ? abc_parameters.cloud_radius : 0.);
+      near_field.assemble(mass, stiffness, lumped, boundary_lumped);
       stiffness *= prm.diffusivity;
-      // Lumped mass: Gauss-Lobatto quadrature at the support points of FE_Q
-      // (equidistant = Gauss-Lobatto for degree <= 2), i.e. the row sums.
-      lumped.reinit(dof_handler.n_dofs());
-      for (unsigned int i = 0; i < dof_handler.n_dofs(); ++i)
-        for (auto e = mass.begin(i); e != mass.end(i); ++e)
-          lumped[i] += e->value();
-
-      C.reinit(dof_handler.n_dofs());
-      rhs.reinit(dof_handler.n_dofs());
-      tmp.reinit(dof_handler.n_dofs());
+      const auto &part = near_field.partitioner;
+      C.reinit(part);
+      rhs.reinit(part);
+      tmp.reinit(part);
       VectorTools::interpolate(dof_handler, initial, C);
-      t = 0.;
+      C.update_ghost_values();
+      t             = 0.;
+      energy_cached = false;
 
-      // Absorbing nodes: the boundary DoFs; normal: sum of the adjacent
-      // boundary-face normals (corners get the diagonal).
-      std::vector<unsigned int>   absorbing;
-      std::vector<Tensor<1, dim>> normals;
-      if (boundary == Abc::TruncationBoundary::absorbing)
+      // Absorbing nodes: the owned boundary DoFs, local frames from their
+      // outward normals; clouds from every available point (ghosts included).
+      std::vector<unsigned int> absorbing_dofs;
+      if (absorbing)
         {
-          std::vector<Tensor<1, dim>>          normal_sum(dof_handler.n_dofs());
-          std::vector<bool>                    on_boundary(dof_handler.n_dofs(), false);
-          std::vector<types::global_dof_index> face_dofs(fe.n_dofs_per_face());
-          for (const auto &cell : dof_handler.active_cell_iterators())
-            for (const unsigned int f : cell->face_indices())
-              if (cell->face(f)->at_boundary())
-                {
-                  Tensor<1, dim> n;
-                  if (dim == 1)
-                    n[0] = f == 0 ? -1. : 1.;
-                  else
-                    {
-                      // Outward normal of a planar face: from the cell centre.
-                      n = cell->face(f)->center() - cell->center();
-                      n /= n.norm();
-                    }
-                  cell->face(f)->get_dof_indices(face_dofs);
-                  for (const auto d : face_dofs)
-                    {
-                      normal_sum[d] += n;
-                      on_boundary[d] = true;
-                    }
-                }
-          for (unsigned int i = 0; i < dof_handler.n_dofs(); ++i)
-            if (on_boundary[i])
-              {
-                absorbing.push_back(i);
-                normals.push_back(normal_sum[i] / normal_sum[i].norm());
-              }
-          std::vector<Point<dim>> points(dof_handler.n_dofs());
-          DoFTools::map_dofs_to_support_points(MappingQ1<dim>(), dof_handler, points);
-          std::vector<types::global_dof_index> ids(dof_handler.n_dofs());
-          for (unsigned int i = 0; i < ids.size(); ++i)
-            ids[i] = i;
-          abc.reinit(points, ids, absorbing, normals,
+          absorbing_dofs = near_field.boundary;
+          abc.reinit(near_field.points, near_field.ids, absorbing_dofs, near_field.normals,
                      Abc::DiffusionDispersion::local(prm.diffusivity), prm.time_step,
-                     abc_parameters, MPI_COMM_SELF);
+                     abc_parameters, near_field.comm);
         }
       else
         abc = Abc::EbfDiffusionAbc<dim>();
@@ -115,25 +65,26 @@ namespace PeriDEAL
       // System matrix: M (consistent explicit) or M + dt K (implicit), with
       // identity rows for the absorbing DoFs (their values are given).
       const bool explicit_lumped = prm.scheme == "forward Euler" && prm.lumped_mass;
-      use_solver                 = !explicit_lumped;
-      if (use_solver)
+      solver.reset();
+      if (!explicit_lumped)
         {
           system.copy_from(mass);
           if (prm.lumped_mass)
             {
               system = 0.;
-              for (unsigned int i = 0; i < dof_handler.n_dofs(); ++i)
-                system.set(i, i, lumped[i]);
+              for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+                system.set(near_field.ids[l], near_field.ids[l], lumped.local_element(l));
+              system.compress(VectorOperation::insert);
             }
           if (prm.scheme == "backward Euler")
             system.add(prm.time_step, stiffness);
-          for (const unsigned int i : absorbing)
-            {
-              for (auto e = system.begin(i); e != system.end(i); ++e)
-                e->value() = 0.;
-              system.set(i, i, 1.);
-            }
-          solver.initialize(system);
+          std::vector<types::global_dof_index> rows;
+          for (const unsigned int l : absorbing_dofs)
+            rows.push_back(near_field.ids[l]);
+          system.clear_rows(rows, 1.);
+          solver = std::make_unique<TrilinosWrappers::SolverDirect>(
+            solver_control, TrilinosWrappers::SolverDirect::AdditionalData(false, "Amesos_Klu"));
+          solver->initialize(system);
         }
 
       // Forward Euler stability: 2 / lambda_max(M^-1 K) by power iteration
@@ -141,24 +92,7 @@ namespace PeriDEAL
       critical_time_step = 0.;
       if (prm.scheme == "forward Euler")
         {
-          SparseDirectUMFPACK mass_solver;
-          if (!prm.lumped_mass)
-            mass_solver.initialize(mass);
-          dealii::Vector<double> x(dof_handler.n_dofs()), y(dof_handler.n_dofs());
-          for (unsigned int i = 0; i < x.size(); ++i)
-            x[i] = (i % 2 ? 1. : -1.) * (1. + 0.1 * std::sin(double(i)));
-          double lambda = 0.;
-          for (unsigned int it = 0; it < 200; ++it)
-            {
-              x /= x.l2_norm();
-              stiffness.vmult(y, x);
-              for (unsigned int i = 0; i < y.size() && prm.lumped_mass; ++i)
-                y[i] /= lumped[i];
-              if (!prm.lumped_mass)
-                mass_solver.solve(y);
-              lambda = x * y;
-              x      = y;
-            }
+          const double lambda = near_field.largest_eigenvalue(stiffness, mass, lumped, prm.lumped_mass);
           // The Rayleigh quotient approaches lambda_max from below: 2 % margin.
           critical_time_step = 2. / (1.02 * lambda);
           check_parameter(prm.time_step <= critical_time_step, "FEM/Time step", prm.time_step,
@@ -174,15 +108,16 @@ namespace PeriDEAL
       using clock      = std::chrono::steady_clock;
       const auto start = clock::now();
       abc.compute(C.begin(), boundary_values);
-      const auto abc_end = clock::now();
-      const auto &absorbing = abc.absorbing_points();
-      const double dt = prm.time_step;
+      const auto    abc_end   = clock::now();
+      const auto   &absorbing = abc.absorbing_points();
+      const double  dt        = prm.time_step;
+      const unsigned int n    = near_field.n_owned();
       if (prm.scheme == "forward Euler")
         {
           stiffness.vmult(tmp, C);
-          if (!use_solver)
-            for (unsigned int i = 0; i < C.size(); ++i)
-              C[i] -= dt * tmp[i] / lumped[i];
+          if (!solver)
+            for (unsigned int i = 0; i < n; ++i)
+              C.local_element(i) -= dt * tmp.local_element(i) / lumped.local_element(i);
           else
             {
               mass.vmult(rhs, C);
@@ -190,25 +125,26 @@ namespace PeriDEAL
             }
         }
       else if (prm.lumped_mass)
-        for (unsigned int i = 0; i < C.size(); ++i)
-          rhs[i] = lumped[i] * C[i];
+        for (unsigned int i = 0; i < n; ++i)
+          rhs.local_element(i) = lumped.local_element(i) * C.local_element(i);
       else
         mass.vmult(rhs, C);
       const auto set_start = clock::now();
-      if (use_solver)
+      if (solver)
         {
           for (unsigned int a = 0; a < absorbing.size(); ++a)
-            rhs[absorbing[a]] = boundary_values[a];
-          solver.solve(rhs);
-          C = rhs;
+            rhs.local_element(absorbing[a]) = boundary_values[a];
+          C.zero_out_ghost_values();
+          solver->solve(C, rhs);
         }
       else
         for (unsigned int a = 0; a < absorbing.size(); ++a)
-          C[absorbing[a]] = boundary_values[a];
+          C.local_element(absorbing[a]) = boundary_values[a];
+      C.update_ghost_values();
       const auto end = clock::now();
       t += dt;
       abc_seconds += std::chrono::duration<double>(abc_end - start).count() +
-                     (use_solver ? 0. : std::chrono::duration<double>(end - set_start).count());
+                     (solver ? 0. : std::chrono::duration<double>(end - set_start).count());
       step_seconds += std::chrono::duration<double>(end - start).count();
     }
 
@@ -216,17 +152,19 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::energy(const BoundingBox<dim> &region) const
     {
-      // integral of C_h^2 = sum over cells of C_c^T M_c C_c; the cell mass
-      // matrices of the region are computed once.
-      if (energy_dofs.empty() || energy_region.get_boundary_points() != region.get_boundary_points())
+      // integral of C_h^2 = sum over owned cells of C_c^T M_c C_c; the cell
+      // mass matrices of the region are computed once.
+      if (!energy_cached || energy_region.get_boundary_points() != region.get_boundary_points())
         {
           energy_region = region;
+          energy_cached = true;
           energy_dofs.clear();
           energy_mass.clear();
           const QGauss<dim> quadrature(fe.degree + 1);
           FEValues<dim>     fe_values(fe, quadrature, update_values | update_JxW_values);
+          std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
           for (const auto &cell : dof_handler.active_cell_iterators())
-            if (region.point_inside(cell->center(), 1e-10))
+            if (cell->is_locally_owned() && region.point_inside(cell->center(), 1e-10))
               {
                 fe_values.reinit(cell);
                 FullMatrix<double> m(fe.n_dofs_per_cell(), fe.n_dofs_per_cell());
@@ -234,8 +172,10 @@ namespace PeriDEAL
                   for (unsigned int i = 0; i < m.m(); ++i)
                     for (unsigned int j = 0; j < m.n(); ++j)
                       m(i, j) += fe_values.shape_value(i, q) * fe_values.shape_value(j, q) * fe_values.JxW(q);
-                energy_dofs.emplace_back(fe.n_dofs_per_cell());
-                cell->get_dof_indices(energy_dofs.back());
+                cell->get_dof_indices(dofs);
+                energy_dofs.emplace_back();
+                for (const auto g : dofs)
+                  energy_dofs.back().push_back(near_field.partitioner->global_to_local(g));
                 energy_mass.push_back(m);
               }
         }
@@ -243,8 +183,9 @@ namespace PeriDEAL
       for (unsigned int c = 0; c < energy_dofs.size(); ++c)
         for (unsigned int i = 0; i < energy_dofs[c].size(); ++i)
           for (unsigned int j = 0; j < energy_dofs[c].size(); ++j)
-            e += C[energy_dofs[c][i]] * energy_mass[c](i, j) * C[energy_dofs[c][j]];
-      return e;
+            e += C.local_element(energy_dofs[c][i]) * energy_mass[c](i, j) *
+                 C.local_element(energy_dofs[c][j]);
+      return Utilities::MPI::sum(e, near_field.comm);
     }
 
     template <int dim>
@@ -252,13 +193,11 @@ namespace PeriDEAL
     FemDiffusion<dim>::max_error(Function<dim> &exact, const BoundingBox<dim> &region) const
     {
       exact.set_time(t);
-      std::vector<Point<dim>> points(dof_handler.n_dofs());
-      DoFTools::map_dofs_to_support_points(MappingQ1<dim>(), dof_handler, points);
-      double     e      = 0.;
-      for (unsigned int i = 0; i < points.size(); ++i)
-        if (region.point_inside(points[i], 1e-10))
-          e = std::max(e, std::abs(C[i] - exact.value(points[i])));
-      return e;
+      double e = 0.;
+      for (unsigned int i = 0; i < near_field.n_owned(); ++i)
+        if (region.point_inside(near_field.points[i], 1e-10))
+          e = std::max(e, std::abs(C.local_element(i) - exact.value(near_field.points[i])));
+      return Utilities::MPI::max(e, near_field.comm);
     }
 
     template class FemDiffusion<1>;

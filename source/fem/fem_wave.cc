@@ -1,14 +1,12 @@
 #include <deal.II/base/quadrature_lib.h>
 
-#include <deal.II/dofs/dof_tools.h>
-
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_q1.h>
 
-#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/grid/grid_tools.h>
+
 #include <deal.II/lac/lapack_full_matrix.h>
 
-#include <deal.II/numerics/matrix_creator.h>
 #include <deal.II/numerics/vector_tools.h>
 
 #include <perideal/base/exceptions.h>
@@ -16,123 +14,126 @@
 
 #include <chrono>
 #include <cmath>
-#include <set>
 
 namespace PeriDEAL
 {
   namespace Fem
   {
+    namespace
+    {
+      /** Newmark average acceleration. */
+      constexpr double newmark_beta = 0.25, newmark_gamma = 0.5;
+    } // namespace
+
     template <int dim>
     FemWave<dim>::FemWave(const Triangulation<dim>    &tria,
                           const FemWaveParameters      &prm,
                           const WaveBoundary            boundary,
                           const Abc::WaveAbcParameters &abc_prm,
                           const Function<dim>          &initial)
-      : fe(prm.degree)
+      : fe((check_parameter(prm.degree == 1 || prm.degree == 2, "FEM/Degree", prm.degree, "1 or 2"),
+            prm.degree))
       , dof_handler(tria)
       , type(boundary)
       , extrapolate_velocity(prm.extrapolate_velocity)
+      , lumped(prm.lumped_mass)
+      , newmark(prm.scheme == "Newmark")
       , chi(prm.wave_speed)
       , d(prm.damping)
       , dt(prm.time_step)
     {
-      check_parameter(prm.degree == 1 || prm.degree == 2, "FEM/Degree", prm.degree, "1 or 2");
       check_parameter(chi > 0., "Model/Wave speed", chi, "> 0");
       check_parameter(d >= 0., "Model/Damping", d, ">= 0");
+      check_parameter(prm.scheme == "velocity Verlet" || prm.scheme == "Newmark", "Time stepping/Scheme",
+                      prm.scheme, "velocity Verlet or Newmark");
+      check_parameter(lumped || newmark, "FEM/Lumped mass", std::string("false"),
+                      "true with the explicit velocity Verlet (consistent mass: scheme Newmark)");
       dof_handler.distribute_dofs(fe);
-      const unsigned int n = dof_handler.n_dofs();
-      DynamicSparsityPattern dsp(n);
-      DoFTools::make_sparsity_pattern(dof_handler, dsp);
-      sparsity.copy_from(dsp);
-      stiffness.reinit(sparsity);
-      MatrixCreator::create_laplace_matrix(dof_handler, QGauss<dim>(prm.degree + 1), stiffness);
+      const bool absorbing = type == WaveBoundary::absorbing;
 
-      // Lumped mass: Gauss-Lobatto points coincide with the FE_Q support
-      // points for degree <= 2, so the mass matrix is diagonal.
-      mass.reinit(n);
-      boundary_mass.reinit(n);
-      {
-        const QGaussLobatto<dim>     q(prm.degree + 1);
-        const QGaussLobatto<dim - 1> qf(prm.degree + 1);
-        FEValues<dim>     fv(fe, q, update_values | update_JxW_values);
-        FEFaceValues<dim> ff(fe, qf, update_values | update_JxW_values);
-        std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
-        for (const auto &cell : dof_handler.active_cell_iterators())
-          {
-            fv.reinit(cell);
-            cell->get_dof_indices(dofs);
-            for (unsigned int i = 0; i < dofs.size(); ++i)
-              for (unsigned int k = 0; k < q.size(); ++k)
-                mass[dofs[i]] += fv.shape_value(i, k) * fv.JxW(k);
-            for (const unsigned int f : cell->face_indices())
-              if (cell->face(f)->at_boundary())
-                {
-                  ff.reinit(cell, f);
-                  for (unsigned int i = 0; i < dofs.size(); ++i)
-                    for (unsigned int k = 0; k < qf.size(); ++k)
-                      boundary_mass[dofs[i]] += ff.shape_value(i, k) * ff.JxW(k);
-                }
-          }
-      }
-      const double dt_crit = critical_time_step();
-      check_parameter(dt > 0. && dt <= dt_crit, "Time stepping/Time step", dt,
-                      "0 < dt <= " + std::to_string(dt_crit) + " (lumped-mass Verlet bound)");
-
-      u.reinit(n);
-      v.reinit(n);
-      a.reinit(n);
-      Ku.reinit(n);
-      VectorTools::interpolate(dof_handler, initial, u);
-      const IndexSet bdofs = DoFTools::extract_boundary_dofs(dof_handler);
-      for (const auto i : bdofs)
-        boundary_dofs.push_back(i);
-      if (type == WaveBoundary::dirichlet)
-        for (const unsigned int i : boundary_dofs)
-          u[i] = 0.;
-      set_acceleration();
-      u_old.assign(u.begin(), u.end());
-      v_old.assign(v.begin(), v.end());
-
-      if (type != WaveBoundary::absorbing)
-        return;
-      // Measured: with FE_Q(2) the EBF update has one-step spectral radius
-      // 1.008 (dt = 0.02, h = 0.5; 1.0002 even with a truncated
-      // pseudo-inverse), against 1.0025 for FE_Q(1) which truncation fixes.
-      check_parameter(prm.degree == 1, "FEM/Degree", prm.degree,
-                      "1 with the EBF absorbing boundary (FE_Q(2) + EBF is unstable: one-step spectral radius > 1)");
-      // Absorbing nodes: the boundary DoFs; outward normal: the average of
-      // the normals of their boundary faces (corners: the diagonal).
-      const MappingQ1<dim>      mapping;
-      std::vector<Point<dim>>   points(n);
-      DoFTools::map_dofs_to_support_points(mapping, dof_handler, points);
-      std::vector<Tensor<1, dim>> normal(n);
-      {
-        const QGauss<dim - 1> qf(1);
-        FEFaceValues<dim>     ff(fe, qf, update_normal_vectors);
-        std::vector<types::global_dof_index> fdofs(fe.n_dofs_per_face());
-        for (const auto &cell : dof_handler.active_cell_iterators())
-          for (const unsigned int f : cell->face_indices())
-            if (cell->face(f)->at_boundary())
-              {
-                ff.reinit(cell, f);
-                cell->face(f)->get_dof_indices(fdofs);
-                for (const auto i : fdofs)
-                  normal[i] += ff.normal_vector(0);
-              }
-      }
-      std::vector<Tensor<1, dim>> normals;
-      for (const unsigned int i : boundary_dofs)
-        normals.push_back(normal[i] / normal[i].norm());
-      std::vector<types::global_dof_index> ids(n);
-      for (unsigned int i = 0; i < n; ++i)
-        ids[i] = i;
+      // Cloud radius (2 node spacings by default) and spacing: needed for
+      // the ghost layer before the vectors exist.
       double h = 0.;
       for (const auto &cell : tria.active_cell_iterators())
-        h = std::max(h, cell->minimum_vertex_distance());
-      const double             spacing = h / prm.degree;
-      Abc::WaveAbcParameters   ap      = abc_prm;
+        if (cell->is_locally_owned())
+          h = std::max(h, cell->minimum_vertex_distance());
+      h                          = Utilities::MPI::max(h, tria.get_communicator());
+      const double           spacing = h / prm.degree;
+      Abc::WaveAbcParameters ap      = abc_prm;
       if (ap.cloud_radius <= 0.)
         ap.cloud_radius = 2. * spacing * (1. + 1e-9);
+      near_field.reinit(dof_handler, absorbing ? ap.cloud_radius : 0.);
+      const auto &part = near_field.partitioner;
+      near_field.assemble(mass_matrix, stiffness, mass, boundary_mass);
+      if (type != WaveBoundary::first_order)
+        boundary_mass = 0.;
+      boundary_dofs = near_field.boundary;
+      if (!newmark)
+        {
+          const double dt_crit = critical_time_step();
+          check_parameter(dt > 0. && dt <= dt_crit, "Time stepping/Time step", dt,
+                          "0 < dt <= " + std::to_string(dt_crit) + " (lumped-mass Verlet bound)");
+        }
+      else
+        check_parameter(dt > 0., "Time stepping/Time step", dt, "> 0");
+
+      for (auto *x : {&u, &v, &a, &Ku, &u_star, &v_star, &rhs, &tmp})
+        x->reinit(part);
+      VectorTools::interpolate(dof_handler, initial, u);
+      if (type == WaveBoundary::dirichlet)
+        for (const unsigned int i : boundary_dofs)
+          u.local_element(i) = 0.;
+      u.update_ghost_values();
+      const unsigned int n_local = near_field.points.size();
+      u_old.assign(u.begin(), u.begin() + n_local);
+      v_old.assign(n_local, 0.);
+
+      // Newmark in displacement form: A u^{n+1} = rhs with
+      // A = (c0 + 2 d c1) M + chi^2 K + chi (c1 + d) B, identity rows for
+      // prescribed (Dirichlet or absorbing) DoFs; M for the initial a.
+      if (!lumped || newmark)
+        {
+          const TrilinosWrappers::SolverDirect::AdditionalData ad(false, "Amesos_Klu");
+          if (!lumped)
+            {
+              mass_solver = std::make_unique<TrilinosWrappers::SolverDirect>(solver_control, ad);
+              mass_solver->initialize(mass_matrix);
+            }
+          const double c0 = 1. / (newmark_beta * dt * dt), c1 = newmark_gamma / (newmark_beta * dt);
+          system.copy_from(mass_matrix);
+          if (lumped)
+            {
+              system = 0.;
+              for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+                system.set(near_field.ids[l], near_field.ids[l], mass.local_element(l));
+              system.compress(VectorOperation::insert);
+            }
+          system *= c0 + 2. * d * c1;
+          system.add(chi * chi, stiffness);
+          for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+            if (boundary_mass.local_element(l) != 0.)
+              system.add(near_field.ids[l], near_field.ids[l], chi * (c1 + d) * boundary_mass.local_element(l));
+          system.compress(VectorOperation::add);
+          if (type != WaveBoundary::first_order)
+            {
+              std::vector<types::global_dof_index> rows;
+              for (const unsigned int l : boundary_dofs)
+                rows.push_back(near_field.ids[l]);
+              system.clear_rows(rows, 1.);
+            }
+          solver = std::make_unique<TrilinosWrappers::SolverDirect>(solver_control, ad);
+          solver->initialize(system);
+        }
+      set_acceleration();
+
+      if (!absorbing)
+        return;
+      // Measured: with FE_Q(2) and velocity Verlet the EBF update has
+      // one-step spectral radius 1.008 (dt = 0.02, h = 0.5; 1.0002 even with
+      // a truncated pseudo-inverse), against 1.0025 for FE_Q(1) which
+      // truncation fixes.
+      check_parameter(prm.degree == 1, "FEM/Degree", prm.degree,
+                      "1 with the EBF absorbing boundary (FE_Q(2) + EBF is unstable: one-step spectral radius > 1)");
       check_parameter(ap.dispersion == "local" || ap.dispersion == "discrete",
                       "Absorbing boundary/Dispersion relation", ap.dispersion,
                       "local or discrete for a FEM near field");
@@ -141,39 +142,53 @@ namespace PeriDEAL
       else
         {
           // The semi-discrete symbol of the lumped-mass scheme from the
-          // stiffness row of the DoF nearest the centre. Q2 has vertex, edge
-          // and cell DoFs with different rows: no single scalar symbol.
-          check_parameter(prm.degree == 1, "FEM/Degree", prm.degree,
-                          "1 with Dispersion relation = discrete (Q2 has no single-row symbol; use local)");
+          // stiffness row of the DoF nearest the centre (of all ranks). Q2
+          // has vertex, edge and cell DoFs with different rows, the
+          // consistent mass a ratio of two symbols: no single-row symbol.
+          check_parameter(prm.degree == 1 && lumped, "FEM/Degree, FEM/Lumped mass", prm.degree,
+                          "1 with lumped mass for Dispersion relation = discrete (otherwise use local)");
           Point<dim> centre;
-          for (const auto &p : points)
-            centre += p / double(n);
-          unsigned int c = 0;
-          for (unsigned int i = 1; i < n; ++i)
-            if (points[i].distance(centre) < points[c].distance(centre))
-              c = i;
-          std::vector<Tensor<1, dim>> offsets;
-          std::vector<double>         weights;
-          for (auto it = stiffness.begin(c); it != stiffness.end(c); ++it)
-            if (it->column() != c)
-              {
-                offsets.push_back(points[it->column()] - points[c]);
-                weights.push_back(-chi * chi * it->value() / mass[c]);
-              }
-          relation = Abc::WaveDispersion<dim>::stencil(offsets, weights, d, "discrete Q1 lumped");
+          for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+            centre += near_field.points[l];
+          for (unsigned int k = 0; k < dim; ++k)
+            centre[k] = Utilities::MPI::sum(centre[k], near_field.comm) / dof_handler.n_dofs();
+          std::pair<double, types::global_dof_index> best(std::numeric_limits<double>::max(), 0);
+          for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+            best = std::min(best, std::make_pair(near_field.points[l].distance(centre), near_field.ids[l]));
+          for (const auto &other : Utilities::MPI::all_gather(near_field.comm, best))
+            best = std::min(best, other);
+          std::pair<std::vector<Tensor<1, dim>>, std::vector<double>> row;
+          if (near_field.owned.is_element(best.second))
+            {
+              const unsigned int c = near_field.partitioner->global_to_local(best.second);
+              for (auto it = stiffness.begin(best.second); it != stiffness.end(best.second); ++it)
+                if (it->column() != best.second)
+                  {
+                    const unsigned int j = near_field.partitioner->global_to_local(it->column());
+                    row.first.push_back(near_field.points[j] - near_field.points[c]);
+                    row.second.push_back(-chi * chi * it->value() / mass.local_element(c));
+                  }
+            }
+          for (const auto &other : Utilities::MPI::all_gather(near_field.comm, row))
+            if (!other.first.empty())
+              row = other;
+          relation = Abc::WaveDispersion<dim>::stencil(row.first, row.second, d, "discrete Q1 lumped");
         }
-      abc.reinit(points, ids, boundary_dofs, normals, relation, dt, spacing, ap, MPI_COMM_SELF);
+      abc.reinit(near_field.points, near_field.ids, boundary_dofs, near_field.normals, relation, dt, spacing, ap,
+                 near_field.comm);
       constant_defect.assign(boundary_dofs.size(), 0.);
       if (prm.preserve_constants)
         {
-          const std::vector<double> ones(n, 1.), zeros(n, 0.);
+          const std::vector<double> ones(n_local, 1.), zeros(n_local, 0.);
           abc.compute(ones.data(), ones.data(), zeros.data(), zeros.data(), u_abc, v_abc);
           for (unsigned int c = 0; c < u_abc.size(); ++c)
             constant_defect[c] = 1. - u_abc[c];
         }
       // Optional global stability guard (the cloud guards of Sect. 4.2.3 are
-      // not sufficient, see doc/design.md).
-      if (ap.spectral_check_size > 0 && 2 * (n + abc.cloud_points().size()) <= ap.spectral_check_size)
+      // not sufficient, see doc/design.md); serial runs only.
+      const unsigned int n = dof_handler.n_dofs();
+      if (ap.spectral_check_size > 0 && Utilities::MPI::n_mpi_processes(near_field.comm) == 1 &&
+          (newmark ? 3 : 2) * n + 2 * abc.cloud_points().size() <= ap.spectral_check_size)
         {
           unsigned int n_up = 0;
           spectral_radius   = one_step_spectral_radius(ap.spectral_check_size, &n_up);
@@ -191,27 +206,46 @@ namespace PeriDEAL
     FemWave<dim>::critical_time_step() const
     {
       double lmax = 0.;
-      for (unsigned int i = 0; i < mass.size(); ++i)
+      for (unsigned int l = 0; l < near_field.n_owned(); ++l)
         {
-          double row = 0.;
+          const auto i   = near_field.ids[l];
+          double     row = 0.;
           for (auto it = stiffness.begin(i); it != stiffness.end(i); ++it)
             row += std::abs(it->value());
-          lmax = std::max(lmax, chi * chi * row / mass[i]);
+          lmax = std::max(lmax, chi * chi * row / mass.local_element(l));
         }
-      return 2. / std::sqrt(lmax);
+      return 2. / std::sqrt(Utilities::MPI::max(lmax, near_field.comm));
+    }
+
+    template <int dim>
+    void
+    FemWave<dim>::apply_mass(const DistributedVector &x, DistributedVector &y) const
+    {
+      if (lumped)
+        for (unsigned int l = 0; l < near_field.n_owned(); ++l)
+          y.local_element(l) = mass.local_element(l) * x.local_element(l);
+      else
+        mass_matrix.vmult(y, x);
     }
 
     template <int dim>
     void
     FemWave<dim>::set_acceleration()
     {
+      // M a = -chi^2 K u - 2 d M v - chi B (v + d u).
+      u.update_ghost_values();
       stiffness.vmult(Ku, u);
-      const bool robin = type == WaveBoundary::first_order;
-      for (unsigned int i = 0; i < u.size(); ++i)
-        {
-          const double b = robin ? chi * boundary_mass[i] / mass[i] : 0.;
-          a[i]           = -chi * chi * Ku[i] / mass[i] - b * d * u[i] - (2. * d + b) * v[i];
-        }
+      const unsigned int n = near_field.n_owned();
+      for (unsigned int i = 0; i < n; ++i)
+        tmp.local_element(i) = -chi * chi * Ku.local_element(i) -
+                               chi * boundary_mass.local_element(i) * (v.local_element(i) + d * u.local_element(i));
+      if (lumped)
+        for (unsigned int i = 0; i < n; ++i)
+          a.local_element(i) = tmp.local_element(i) / mass.local_element(i);
+      else
+        mass_solver->solve(a, tmp);
+      a.add(-2. * d, v);
+      v.update_ghost_values();
     }
 
     template <int dim>
@@ -220,20 +254,25 @@ namespace PeriDEAL
                                            unsigned int         *n_unstable,
                                            std::complex<double> *dominant)
     {
+      check_parameter(Utilities::MPI::n_mpi_processes(near_field.comm) == 1, "MPI processes",
+                      Utilities::MPI::n_mpi_processes(near_field.comm), "1 for the dense spectral radius check");
       const unsigned int               n = u.size();
       const std::vector<unsigned int> &c = abc.cloud_points();
       const bool                       absorbing = type == WaveBoundary::absorbing;
-      const unsigned int               m = 2 * n + (absorbing ? 2 * c.size() : 0);
+      const unsigned int               n_fields  = newmark ? 3 : 2;
+      const unsigned int               m = n_fields * n + (absorbing ? 2 * c.size() : 0);
       check_parameter(m <= max_size, "State size of the spectral radius check", m,
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
-      const dealii::Vector<double> u0 = u, v0 = v, a0 = a;
-      const std::vector<double>    uo0 = u_old, vo0 = v_old;
-      const double                 t0 = t, abc0 = abc_seconds, step0 = step_seconds;
-      LAPACKFullMatrix<double>     map(m, m);
+      const DistributedVector   u0 = u, v0 = v, a0 = a;
+      const std::vector<double> uo0 = u_old, vo0 = v_old;
+      const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      LAPACKFullMatrix<double>  map(m, m);
+      const unsigned int        cs = n_fields * n;
       for (unsigned int col = 0; col < m; ++col)
         {
           u = 0.;
           v = 0.;
+          a = 0.;
           if (absorbing)
             for (const unsigned int q : c)
               u_old[q] = v_old[q] = 0.;
@@ -241,22 +280,27 @@ namespace PeriDEAL
             u[col] = 1.;
           else if (col < 2 * n)
             v[col - n] = 1.;
-          else if (col < 2 * n + c.size())
-            u_old[c[col - 2 * n]] = 1.;
+          else if (col < cs)
+            a[col - 2 * n] = 1.;
+          else if (col < cs + c.size())
+            u_old[c[col - cs]] = 1.;
           else
-            v_old[c[col - 2 * n - c.size()]] = 1.;
-          set_acceleration();
+            v_old[c[col - cs - c.size()]] = 1.;
+          if (!newmark)
+            set_acceleration();
           advance();
           for (unsigned int i = 0; i < n; ++i)
             {
               map(i, col)     = u[i];
               map(n + i, col) = v[i];
+              if (newmark)
+                map(2 * n + i, col) = a[i];
             }
           if (absorbing)
             for (unsigned int q = 0; q < c.size(); ++q)
               {
-                map(2 * n + q, col)            = u_old[c[q]];
-                map(2 * n + c.size() + q, col) = v_old[c[q]];
+                map(cs + q, col)            = u_old[c[q]];
+                map(cs + c.size() + q, col) = v_old[c[q]];
               }
         }
       u            = u0;
@@ -285,58 +329,117 @@ namespace PeriDEAL
 
     template <int dim>
     void
+    FemWave<dim>::extrapolate_boundary()
+    {
+      // Only the cloud entries of the previous level are read.
+      if (extrapolate_velocity)
+        {
+          abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
+          for (const unsigned int q : abc.cloud_points())
+            v_old[q] = v.local_element(q);
+        }
+      else
+        abc.compute_values(u.begin(), u_old.data(), u_abc);
+      for (const unsigned int q : abc.cloud_points())
+        u_old[q] = u.local_element(q);
+    }
+
+    template <int dim>
+    void
     FemWave<dim>::advance()
     {
-      using clock                = std::chrono::steady_clock;
-      const auto         start   = clock::now();
-      const unsigned int n    = u.size();
-      const double       half = 0.5 * dt;
+      using clock      = std::chrono::steady_clock;
+      const auto start = clock::now();
       if (type == WaveBoundary::absorbing)
         {
           const auto abc_start = clock::now();
-          // Only the cloud entries of the previous level are read.
-          if (extrapolate_velocity)
-            {
-              abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
-              for (const unsigned int q : abc.cloud_points())
-                v_old[q] = v[q];
-            }
-          else
-            abc.compute_values(u.begin(), u_old.data(), u_abc);
-          for (const unsigned int q : abc.cloud_points())
-            u_old[q] = u[q];
+          extrapolate_boundary();
           abc_seconds += std::chrono::duration<double>(clock::now() - abc_start).count();
         }
+      if (newmark)
+        advance_newmark();
+      else
+        advance_verlet();
+      t += dt;
+      v.update_ghost_values();
+      step_seconds += std::chrono::duration<double>(clock::now() - start).count();
+    }
+
+    template <int dim>
+    void
+    FemWave<dim>::advance_verlet()
+    {
+      const unsigned int n     = near_field.n_owned();
+      const double       half  = 0.5 * dt;
+      const auto        &nodes = abc.absorbing_points();
       for (unsigned int i = 0; i < n; ++i)
         {
-          u[i] += dt * (v[i] + half * a[i]);
-          v[i] += half * a[i];
+          u.local_element(i) += dt * (v.local_element(i) + half * a.local_element(i));
+          v.local_element(i) += half * a.local_element(i);
         }
+      if (type == WaveBoundary::absorbing)
+        for (unsigned int c = 0; c < nodes.size(); ++c)
+          u.local_element(nodes[c]) = u_abc[c] + constant_defect[c] * u_old[nodes[c]];
+      else if (type == WaveBoundary::dirichlet)
+        for (const unsigned int i : boundary_dofs)
+          u.local_element(i) = 0.;
+      u.update_ghost_values();
+      stiffness.vmult(Ku, u);
+      // M a = -chi^2 K u - 2 d M v - chi B (v + d u); B = 0 unless first order.
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          const double b = chi * boundary_mass.local_element(i) / mass.local_element(i);
+          const double f = -chi * chi * Ku.local_element(i) / mass.local_element(i) - b * d * u.local_element(i);
+          v.local_element(i) = (v.local_element(i) + half * f) / (1. + dt * d + half * b);
+          a.local_element(i) = f - (2. * d + b) * v.local_element(i);
+        }
+      if (type == WaveBoundary::absorbing)
+        for (unsigned int c = 0; c < nodes.size(); ++c)
+          v.local_element(nodes[c]) =
+            extrapolate_velocity ? v_abc[c] : (u.local_element(nodes[c]) - u_old[nodes[c]]) / dt;
+      else if (type == WaveBoundary::dirichlet)
+        for (const unsigned int i : boundary_dofs)
+          v.local_element(i) = a.local_element(i) = 0.;
+    }
+
+    template <int dim>
+    void
+    FemWave<dim>::advance_newmark()
+    {
+      // Displacement form: u* = u + dt v + dt^2 (1/2 - beta) a,
+      // v* = v + (1 - gamma) dt a, a^{n+1} = c0 (u^{n+1} - u*),
+      // v^{n+1} = v* + gamma dt a^{n+1}; the equation of motion at t^{n+1}
+      // gives A u^{n+1} = M ((c0 + 2 d c1) u* - 2 d v*) + chi B (c1 u* - v*).
+      const unsigned int n  = near_field.n_owned();
+      const double       c0 = 1. / (newmark_beta * dt * dt), c1 = newmark_gamma / (newmark_beta * dt);
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          const double us = u.local_element(i) + dt * v.local_element(i) +
+                            dt * dt * (0.5 - newmark_beta) * a.local_element(i);
+          const double vs = v.local_element(i) + (1. - newmark_gamma) * dt * a.local_element(i);
+          u_star.local_element(i) = us;
+          v_star.local_element(i) = vs;
+          tmp.local_element(i)    = (c0 + 2. * d * c1) * us - 2. * d * vs;
+        }
+      apply_mass(tmp, rhs);
+      for (unsigned int i = 0; i < n; ++i)
+        rhs.local_element(i) +=
+          chi * boundary_mass.local_element(i) * (c1 * u_star.local_element(i) - v_star.local_element(i));
       const auto &nodes = abc.absorbing_points();
       if (type == WaveBoundary::absorbing)
         for (unsigned int c = 0; c < nodes.size(); ++c)
-          u[nodes[c]] = u_abc[c] + constant_defect[c] * u_old[nodes[c]];
+          rhs.local_element(nodes[c]) = u_abc[c] + constant_defect[c] * u_old[nodes[c]];
       else if (type == WaveBoundary::dirichlet)
         for (const unsigned int i : boundary_dofs)
-          u[i] = 0.;
-      t += dt;
-      stiffness.vmult(Ku, u);
-      // M a = -chi^2 K u - 2 d M v - chi B (v + d u); B = 0 unless first order.
-      const bool robin = type == WaveBoundary::first_order;
+          rhs.local_element(i) = 0.;
+      u.zero_out_ghost_values();
+      solver->solve(u, rhs);
+      u.update_ghost_values();
       for (unsigned int i = 0; i < n; ++i)
         {
-          const double b = robin ? chi * boundary_mass[i] / mass[i] : 0.;
-          const double f = -chi * chi * Ku[i] / mass[i] - b * d * u[i];
-          v[i]           = (v[i] + half * f) / (1. + dt * d + half * b);
-          a[i]           = f - (2. * d + b) * v[i];
+          a.local_element(i) = c0 * (u.local_element(i) - u_star.local_element(i));
+          v.local_element(i) = v_star.local_element(i) + newmark_gamma * dt * a.local_element(i);
         }
-      if (type == WaveBoundary::absorbing)
-        for (unsigned int c = 0; c < nodes.size(); ++c)
-          v[nodes[c]] = extrapolate_velocity ? v_abc[c] : (u[nodes[c]] - u_old[nodes[c]]) / dt;
-      else if (type == WaveBoundary::dirichlet)
-        for (const unsigned int i : boundary_dofs)
-          v[i] = a[i] = 0.;
-      step_seconds += std::chrono::duration<double>(clock::now() - start).count();
     }
 
     template <int dim>
@@ -349,7 +452,7 @@ namespace PeriDEAL
       std::vector<Tensor<1, dim>> gq(q.size());
       double                      e = 0.;
       for (const auto &cell : dof_handler.active_cell_iterators())
-        if (inside(cell->center()))
+        if (cell->is_locally_owned() && inside(cell->center()))
           {
             fv.reinit(cell);
             fv.get_function_values(v, vq);
@@ -357,14 +460,33 @@ namespace PeriDEAL
             for (unsigned int k = 0; k < q.size(); ++k)
               e += 0.5 * (vq[k] * vq[k] + chi * chi * gq[k] * gq[k]) * fv.JxW(k);
           }
-      return e;
+      return Utilities::MPI::sum(e, near_field.comm);
     }
 
     template <int dim>
     double
     FemWave<dim>::value_at(const Point<dim> &p) const
     {
-      return VectorTools::point_value(dof_handler, u, p);
+      // The owning rank of the cell containing p evaluates; serial: directly.
+      if (Utilities::MPI::n_mpi_processes(near_field.comm) == 1)
+        return VectorTools::point_value(dof_handler, u, p);
+      double value = 0., found = 0.;
+      try
+        {
+          const auto [cell, ref] = GridTools::find_active_cell_around_point(MappingQ1<dim>(), dof_handler, p);
+          if (cell.state() == IteratorState::valid && cell->is_locally_owned())
+            {
+              std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+              cell->get_dof_indices(dofs);
+              for (unsigned int i = 0; i < dofs.size(); ++i)
+                value += u(dofs[i]) * fe.shape_value(i, ref);
+              found = 1.;
+            }
+        }
+      catch (...)
+        {}
+      const double n_found = Utilities::MPI::sum(found, near_field.comm);
+      return n_found > 0. ? Utilities::MPI::sum(value, near_field.comm) / n_found : 0.;
     }
 
     template class FemWave<1>;

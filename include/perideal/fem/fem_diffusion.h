@@ -11,13 +11,14 @@
 #include <deal.II/grid/tria.h>
 
 #include <deal.II/lac/full_matrix.h>
-#include <deal.II/lac/sparse_direct.h>
-#include <deal.II/lac/sparse_matrix.h>
-#include <deal.II/lac/sparsity_pattern.h>
-#include <deal.II/lac/vector.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 
 #include <perideal/abc/ebf_diffusion_abc.h>
 #include <perideal/abc/pd_unbounded_diffusion.h>
+#include <perideal/fem/near_field.h>
+
+#include <memory>
 
 #include <string>
 
@@ -42,13 +43,17 @@ namespace PeriDEAL
 
     /**
      * Classical diffusion (4.1) C_t = D Laplace C with continuous FE_Q
-     * elements on a serial deal.II triangulation: M dC/dt + K C = 0 (4.32)
+     * elements on a serial or parallel::distributed triangulation (any
+     * GridGenerator mesh: segment, square, disk): M dC/dt + K C = 0 (4.32)
      * marched with forward or backward Euler. The truncation boundary is
      * either natural (homogeneous Neumann) or absorbing: the boundary DoFs
-     * are the absorbing nodes of the EBF ABC, whose values at t^{n+1}
-     * (computed from the DoF values at t^n) enter the step as
-     * time-dependent Dirichlet rows. Systems are factorized once
-     * (UMFPACK); with lumped mass the explicit step needs no solve.
+     * are the absorbing nodes of the EBF ABC (local frame from the outward
+     * normal), whose values at t^{n+1} (computed from the DoF values at
+     * t^n) enter the step as time-dependent Dirichlet rows. Clouds may
+     * straddle ranks: their DoFs are ghosts (NearFieldLayout), so the
+     * result does not depend on the number of ranks. Systems are
+     * factorized once (Trilinos Amesos KLU); with lumped mass the explicit
+     * step needs no solve.
      */
     template <int dim>
     class FemDiffusion
@@ -83,7 +88,8 @@ namespace PeriDEAL
       {
         return t;
       }
-      const dealii::Vector<double> &
+      /** The solution (owned DoFs, then ghosts; see layout()). */
+      const DistributedVector &
       solution() const
       {
         return C;
@@ -92,6 +98,12 @@ namespace PeriDEAL
       get_dof_handler() const
       {
         return dof_handler;
+      }
+      /** DoF layout: support points, ids, boundary DoFs. */
+      const NearFieldLayout<dim> &
+      layout() const
+      {
+        return near_field;
       }
       const Abc::EbfDiffusionAbc<dim> &
       absorbing_boundary() const
@@ -104,23 +116,24 @@ namespace PeriDEAL
       double abc_seconds = 0., step_seconds = 0.;
 
     private:
-      const Triangulation<dim> &tria;
-      FemDiffusionParameters    prm;
-      FE_Q<dim>                 fe;
-      DoFHandler<dim>           dof_handler;
-      SparsityPattern           sparsity;
-      SparseMatrix<double>      mass, stiffness, system;
-      dealii::Vector<double>            lumped;
-      SparseDirectUMFPACK       solver;
-      bool                      use_solver = false;
-      Abc::EbfDiffusionAbc<dim> abc;
-      std::vector<double>       boundary_values;
-      /** energy(): cells of the last region, their DoFs and local mass matrices. */
-      mutable BoundingBox<dim>                                  energy_region;
-      mutable std::vector<std::vector<types::global_dof_index>> energy_dofs;
-      mutable std::vector<FullMatrix<double>>                   energy_mass;
-      dealii::Vector<double>            C, rhs, tmp;
-      double                    t = 0.;
+      const Triangulation<dim>      &tria;
+      FemDiffusionParameters         prm;
+      FE_Q<dim>                      fe;
+      DoFHandler<dim>                dof_handler;
+      NearFieldLayout<dim>           near_field;
+      TrilinosWrappers::SparseMatrix mass, stiffness, system;
+      DistributedVector              lumped, boundary_lumped;
+      SolverControl                  solver_control;
+      std::unique_ptr<TrilinosWrappers::SolverDirect> solver;
+      Abc::EbfDiffusionAbc<dim>      abc;
+      std::vector<double>            boundary_values;
+      /** energy(): cells of the last region, local indices of their DoFs and local mass matrices. */
+      mutable BoundingBox<dim>                       energy_region;
+      mutable bool                                   energy_cached = false;
+      mutable std::vector<std::vector<unsigned int>> energy_dofs;
+      mutable std::vector<FullMatrix<double>>        energy_mass;
+      DistributedVector                              C, rhs, tmp;
+      double                                         t = 0.;
     };
   } // namespace Fem
 } // namespace PeriDEAL

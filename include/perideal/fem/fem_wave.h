@@ -9,14 +9,15 @@
 
 #include <deal.II/grid/tria.h>
 
-#include <deal.II/lac/sparse_matrix.h>
-#include <deal.II/lac/sparsity_pattern.h>
-#include <deal.II/lac/vector.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 
 #include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/fem/near_field.h>
 
 #include <complex>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,8 +34,16 @@ namespace PeriDEAL
       double wave_speed = 1.;
       /** Damping d >= 0 of u_tt + 2 d u_t = chi^2 Laplace u. */
       double damping = 0.;
-      /** Time step (> 0, below the lumped-mass CFL bound). */
+      /** Time step (> 0; velocity Verlet: below the lumped-mass CFL bound). */
       double time_step = 0.;
+      /** Lumped (row sums, diagonal) or consistent mass matrix (consistent: scheme Newmark only). */
+      bool lumped_mass = true;
+      /**
+       * "velocity Verlet" (explicit, damped (4.62)) or "Newmark" (implicit
+       * average acceleration, beta = 1/4, gamma = 1/2: unconditionally
+       * stable for the interior, one Trilinos KLU factorization at setup).
+       */
+      std::string scheme = "velocity Verlet";
       /**
        * EBF ABC: extrapolate u - u_i^n instead of u at absorbing DoF i, i.e.
        * add (1 - sum_j V_G,j) u_i^n, so that the static state u = const (an
@@ -66,12 +75,16 @@ namespace PeriDEAL
 
     /**
      * Viscous scalar wave equation u_tt + 2 d u_t = chi^2 Laplace u (2.37)
-     * with deal.II FE_Q elements (degree 1 or 2), lumped mass (Gauss-Lobatto
-     * quadrature at the support points) and damped velocity Verlet. The
-     * truncation boundary is absorbing (EBF, the same Abc::EbfWaveAbc as the
-     * PD near field, clouds from the DoF support points), first-order
+     * with deal.II FE_Q elements (degree 1 or 2) on a serial or
+     * parallel::distributed triangulation (squares, disks, ...): lumped mass
+     * with damped velocity Verlet, or lumped/consistent mass with implicit
+     * Newmark (average acceleration). The truncation boundary is absorbing
+     * (EBF, the same Abc::EbfWaveAbc as the PD near field, clouds from the
+     * DoF support points, local frames from the outward normal, u^{n+1} of
+     * the boundary DoFs as time-dependent Dirichlet data), first-order
      * absorbing (Robin term chi int_Gamma (u_t + d u) w, lumped), or
-     * homogeneous Dirichlet. Serial.
+     * homogeneous Dirichlet. Cloud DoFs of other ranks are ghosts, so the
+     * result does not depend on the number of ranks.
      */
     template <int dim>
     class FemWave
@@ -83,7 +96,7 @@ namespace PeriDEAL
               const Abc::WaveAbcParameters   &abc,
               const Function<dim>            &initial);
 
-      /** One damped velocity-Verlet step. */
+      /** One time step (velocity Verlet or Newmark). */
       void
       advance();
 
@@ -93,14 +106,15 @@ namespace PeriDEAL
       /** u at @p p. */
       double
       value_at(const Point<dim> &p) const;
-      /** Largest stable time step 2/sqrt(lambda_max) (Gershgorin bound of M^-1 K chi^2). */
+      /** Largest stable velocity-Verlet step 2/sqrt(lambda_max) (Gershgorin bound of M_lumped^-1 K chi^2). */
       double
       critical_time_step() const;
       /**
        * Spectral radius of the linear one-step map of the truncated system
-       * (Verlet plus boundary treatment), the FEM counterpart of
-       * Abc::PdUnboundedWave::one_step_spectral_radius: state (u, v of all
-       * DoFs, u^{n-1}, v^{n-1} of the cloud points), mapped column by column
+       * (time integrator plus boundary treatment), the FEM counterpart of
+       * Abc::PdUnboundedWave::one_step_spectral_radius: state (u, v, and for
+       * Newmark a, of all DoFs, u^{n-1}, v^{n-1} of the cloud points;
+       * serial runs only), mapped column by column
        * through advance(), eigenvalues by LAPACK. At most @p max_size state
        * entries (ParameterError otherwise); the state is restored. The number
        * of eigenvalues with modulus > 1 + 1e-8 goes to @p n_unstable.
@@ -143,26 +157,52 @@ namespace PeriDEAL
       {
         return dof_handler;
       }
+      /** DoF layout: support points, ids, boundary DoFs. */
+      const NearFieldLayout<dim> &
+      layout() const
+      {
+        return near_field;
+      }
+      /** The displacement u (owned DoFs, then ghosts). */
+      const DistributedVector &
+      solution() const
+      {
+        return u;
+      }
 
     private:
-      FE_Q<dim>                  fe;
-      DoFHandler<dim>            dof_handler;
-      SparsityPattern            sparsity;
-      SparseMatrix<double>       stiffness;
-      dealii::Vector<double>     mass, boundary_mass, u, v, a, Ku;
+      FE_Q<dim>                      fe;
+      DoFHandler<dim>                dof_handler;
+      NearFieldLayout<dim>           near_field;
+      TrilinosWrappers::SparseMatrix stiffness, mass_matrix, system;
+      SolverControl                  solver_control;
+      std::unique_ptr<TrilinosWrappers::SolverDirect> solver, mass_solver;
+      DistributedVector              mass, boundary_mass, u, v, a, Ku, u_star, v_star, rhs, tmp;
+      /** Local indices of the owned boundary DoFs. */
       std::vector<unsigned int>  boundary_dofs;
       Abc::EbfWaveAbc<dim>       abc;
       Abc::WaveDispersion<dim>   relation;
+      /** Previous level of the cloud points (local numbering). */
       std::vector<double>        u_old, v_old, u_abc, v_abc;
       /** 1 - V_G . 1 per absorbing DoF (0 without the constant correction). */
       std::vector<double>        constant_defect;
       WaveBoundary               type;
-      bool                       extrapolate_velocity;
+      bool                       extrapolate_velocity, lumped, newmark;
       double                     chi, d, dt, t = 0.;
 
       /** a from the current u, v (what advance() leaves at every non-boundary DoF). */
       void
       set_acceleration();
+      /** rhs = M x (lumped or consistent). */
+      void
+      apply_mass(const DistributedVector &x, DistributedVector &y) const;
+      void
+      advance_verlet();
+      void
+      advance_newmark();
+      /** u^{n+1} of the absorbing DoFs from the cloud data of level n, n-1 (then level n becomes n-1). */
+      void
+      extrapolate_boundary();
     };
   } // namespace Fem
 } // namespace PeriDEAL

@@ -1,0 +1,9 @@
+perideal_add_test_program(fem_mpi_tests ${CMAKE_CURRENT_LIST_DIR}/fem_mpi_tests.cc)
+# 1 vs 2 ranks: parallel::distributed runs equal the serial ones DoF by DoF.
+foreach(_t rank_invariance_diffusion rank_invariance_wave)
+  perideal_add_test(NAME fem_mpi.${_t}.np2 NPROCS 2 COMMAND $<TARGET_FILE:fem_mpi_tests> ${_t} LABELS mpi)
+endforeach()
+# Disk near fields: diffusion vs the heat kernel, waves vs an extended disk.
+foreach(_t disk_diffusion disk_wave)
+  perideal_add_test(NAME fem_mpi.${_t} COMMAND $<TARGET_FILE:fem_mpi_tests> ${_t} LABELS convergence)
+endforeach()
