@@ -483,6 +483,11 @@ namespace
     types::global_dof_index n_nodes = 0, n_absorbing = 0;
     /** Clouds with points owned by another rank. */
     unsigned int n_straddling = 0;
+    /** The ABC's cloud statistics and the setup's one-step growth. */
+    Abc::CloudStatistics stats;
+    double               growth = 0.;
+    /** Per absorbing cloud (this rank): sum_j V_j and the blend theta. */
+    std::vector<double> sum_v, theta;
   };
 
   /**
@@ -522,6 +527,16 @@ namespace
             break;
           }
     r.n_straddling = Utilities::MPI::sum(r.n_straddling, comm);
+    r.stats        = abc.statistics();
+    r.growth       = run.stability_growth;
+    for (unsigned int a = 0; a < abc.absorbing_points().size(); ++a)
+      {
+        double sum = 0.;
+        for (const auto &[j, v] : abc.cloud(a))
+          sum += v;
+        r.sum_v.push_back(sum);
+        r.theta.push_back(abc.blend(a));
+      }
     double previous = run.energy(region);
     r.energy.push_back(previous);
     r.solid.push_back(run.solid_volume());
@@ -818,7 +833,7 @@ namespace
    * solid volume.
    */
   template <int dim>
-  void
+  CorrosionRecord
   corrosion_case(const CorrosionCase &c, const LatticeParameters &lp, const DiffusionModelParameters &model,
                  const Abc::EbfParameters &ap, const Function<dim> &c0)
   {
@@ -857,6 +872,7 @@ namespace
             "x closer to the reference than Neumann at t_end (ratio " +
             sci(dn.first / da_final.first) + ")");
     check(abc.monotone, name + "near-field energy non-increasing every step (Fig. 4.16)");
+    return abc;
   }
 
   void
@@ -973,16 +989,36 @@ namespace
                   << run.stability_growth << std::endl;
       check(min_v >= 0. && max_sum_error < 1e-12, "monotone fit: V_j >= 0 and sum_j V_j = 1 in every cloud");
     }
+    // The stabilized fit: least squares except on the clouds of the
+    // growing modes, blended toward the monotone fit until the power
+    // iteration of the one-step map decays.
     // R_ref = 2: the run ends before the solid's concentration (gone at t =
     // 0.00275) reaches it, exp(-1.5^2 / (4 D_liq t_end)) = 0.08 of the
-    // front; it is the reference for Omega_N = |x| <= 0.8 only. Measured
-    // with the monotone fit: max Delta Pi/Pi0 7.5e-3 (the ABC under-absorbs
-    // late: Pi/Pi0 0.028 vs 0.020 at t_end), Neumann 4.6e-2 at t_end, gain
-    // 6.1. Asserted: 1e-2 over the run, gain >= 5; the radius-10 dx sphere
-    // is half absorbing layer (2,060 of 4,169 nodes).
-    CorrosionCase c{1., 2., dt, 0.005, 25, 1e-2, 1e-3};
-    c.required_gain = 5.;
-    corrosion_case<3>(c, lp, e10_model(), ap, c0);
+    // front; it is the reference for Omega_N = |x| <= 0.8 only. Measured:
+    // monotone fit max Delta Pi/Pi0 7.4e-3 (the ABC under-absorbs late:
+    // Pi/Pi0 0.028 vs 0.020 at t_end), Neumann 4.5e-2 at t_end, gain 6.1;
+    // stabilized fit (9 rounds, 751 of 2,060 clouds blended, growth 0.9988)
+    // max 3.8e-3, final 1.4e-3, gain 32.6. Asserted: 5e-3 over the run and
+    // the gain >= 10 of the issue; the radius-10 dx sphere is half absorbing
+    // layer (2,060 of 4,169 nodes).
+    ap.fit = "stabilized";
+    CorrosionCase c{1., 2., dt, 0.005, 25, 5e-3, 1e-3};
+    const auto    abc = corrosion_case<3>(c, lp, e10_model(), ap, c0);
+    double        max_theta_error = 0.;
+    for (const double th : abc.theta)
+      max_theta_error = std::max(max_theta_error, th < 0. ? -th : (th > 1. ? th - 1. : 0.));
+    max_theta_error = Utilities::MPI::max(max_theta_error, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "  stabilized fit: " << abc.stats.n_blended << " of " << abc.stats.n_absorbing
+                << " clouds blended (max theta " << abc.stats.max_blend << ") in "
+                << abc.stats.stabilization_rounds << " rounds, max sum |V_j| " << abc.stats.max_update_l1
+                << ", one-step growth " << abc.growth << std::endl;
+    check(abc.growth <= 1. && max_theta_error == 0.,
+          "stabilized fit: one-step growth <= 1 and blend theta in [0, 1]");
+    // Least squares where it is stable: the blend must be local, not the
+    // monotone fit everywhere.
+    check(abc.stats.n_blended > 0 && abc.stats.n_blended < abc.stats.n_absorbing / 2,
+          "stabilized fit: the blend acts on some, fewer than half, of the clouds");
   }
 
   double
