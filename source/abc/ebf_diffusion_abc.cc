@@ -469,7 +469,8 @@ namespace PeriDEAL
           // That is sufficient only: stable least-squares runs reach 2.1
           // (2D disc), so the guard is off by default and the PD near field
           // checks the one-step map itself (PdUnboundedDiffusion).
-          const bool l1_ok = monotone || vl1 <= prm.max_update_l1;
+          // (The stabilized fit applies the l1 bound as a cap on its blend.)
+          const bool l1_ok = monotone || prm.fit == "stabilized" || vl1 <= prm.max_update_l1;
           if (!(cond <= prm.max_condition_number) || !(vmax <= prm.max_update_norm) || !l1_ok)
             {
               std::ostringstream v;

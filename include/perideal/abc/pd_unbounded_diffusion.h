@@ -143,12 +143,17 @@ namespace PeriDEAL
       check_stability(const unsigned int n_steps);
 
       /**
-       * The "stabilized" fit: rounds of @p n_steps of power iteration; while
+       * The "stabilized" fit: rounds of @p n_steps of power iteration from a
+       * random start on the nodes @p in_clouds (near the boundary); while
        * the map grows, the clouds carrying the growing vector move halfway
-       * from least squares to the monotone fit.
+       * from least squares to the monotone fit. Before that, clouds with
+       * sum_j |V_j| > @p l1_cap are blended until they are below it.
        */
       void
-      stabilize(const unsigned int n_steps, const unsigned int max_rounds);
+      stabilize(const unsigned int       n_steps,
+                const unsigned int       max_rounds,
+                const std::vector<bool> &in_clouds,
+                const double             l1_cap);
 
       /**
        * @p n_steps of the one-step map on @p u (normalized every step,
