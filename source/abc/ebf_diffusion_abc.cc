@@ -81,6 +81,53 @@ namespace PeriDEAL
           }
         return x;
       }
+
+      /**
+       * min |V M - psi| subject to sum_j V_j = 1, sum_j |V_j| <= 1 +
+       * l1_excess and (lower_bound >= 0) V_j >= -lower_bound, as a
+       * nonnegative least-squares problem in V = P - N with P, N >= 0 and
+       * slacks for the inequalities; the equalities by heavily weighted rows
+       * (the weighting method), placed first for the unpivoted QR. The
+       * monotone fit is l1_excess = 0.
+       */
+      Eigen::RowVectorXd
+      bounded_fit(const Eigen::MatrixXd &M, const Eigen::RowVectorXd &psi, const double l1_excess,
+                  const double lower_bound)
+      {
+        const Eigen::Index n = M.rows(), n_modes = M.cols();
+        const bool         bounded = lower_bound >= 0.;
+        const bool         signed_weights = l1_excess > 0.;
+        // Columns: P, N (signed only), one l1 slack, n bound slacks.
+        const Eigen::Index n_var = signed_weights ? 2 * n + 1 + (bounded ? n : 0) : n;
+        const Eigen::Index n_eq  = signed_weights ? 2 + (bounded ? n : 0) : 1;
+        const double       w     = 1e4 * std::sqrt(double(n_modes));
+        Eigen::MatrixXd    A     = Eigen::MatrixXd::Zero(n_eq + n_modes, n_var);
+        Eigen::VectorXd    b     = Eigen::VectorXd::Zero(n_eq + n_modes);
+        A.block(0, 0, 1, n).setConstant(w);
+        b[0] = w;
+        A.block(n_eq, 0, n_modes, n) = M.transpose();
+        b.tail(n_modes)              = psi.transpose();
+        if (signed_weights)
+          {
+            A.block(0, n, 1, n).setConstant(-w);
+            A.block(1, n, 1, n).setConstant(w);
+            A(1, 2 * n) = w;
+            b[1]        = w * 0.5 * l1_excess; // sum|V| = 1 + 2 sum N
+            A.block(n_eq, n, n_modes, n) = -M.transpose();
+            if (bounded)
+              for (Eigen::Index j = 0; j < n; ++j)
+                {
+                  A(2 + j, n + j)         = w;
+                  A(2 + j, 2 * n + 1 + j) = w;
+                  b[2 + j]                = w * lower_bound;
+                }
+          }
+        const Eigen::VectorXd x = nonnegative_least_squares(A, b);
+        Eigen::RowVectorXd    V = x.head(n).transpose();
+        if (signed_weights)
+          V -= x.segment(n, n).transpose();
+        return V / V.sum();
+      }
     } // namespace
 
 
@@ -103,9 +150,18 @@ namespace PeriDEAL
       prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
                         "Guard on max_j |V_j|.");
       prm.declare_entry("Updating vector fit", "least squares",
-                        Patterns::Selection("least squares|monotone"),
+                        Patterns::Selection("least squares|monotone|bounded|stabilized"),
                         "least squares: V = Psi M^+ (4.31); monotone: least squares with V_j >= 0, "
-                        "sum V_j = 1 (stable for any cloud shape).");
+                        "sum V_j = 1 (stable for any cloud shape); bounded: least squares with "
+                        "sum V_j = 1, sum |V_j| <= 1 + l1 excess, V_j >= -lower bound; stabilized "
+                        "(PD): per cloud (1 - theta) least squares + theta monotone, theta raised "
+                        "on the clouds of growing modes until the one-step map is stable.");
+      prm.declare_entry("Updating vector l1 excess", "0.5", Patterns::Double(0.),
+                        "bounded fit: sum_j |V_j| <= 1 + this (0: the monotone fit).");
+      prm.declare_entry("Updating vector lower bound", "-1", Patterns::Double(),
+                        "bounded fit: V_j >= -this (negative: no bound).");
+      prm.declare_entry("Maximum stabilization rounds", "60", Patterns::Integer(1, 1000),
+                        "stabilized fit: rounds of power iteration and blending.");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
@@ -128,9 +184,15 @@ namespace PeriDEAL
       fit                  = prm.get("Updating vector fit");
       max_update_l1        = prm.get_double("Maximum updating vector l1 norm");
       stability_check_steps = prm.get_integer("Stability check steps");
+      l1_excess             = prm.get_double("Updating vector l1 excess");
+      lower_bound           = prm.get_double("Updating vector lower bound");
+      max_stabilization_rounds = prm.get_integer("Maximum stabilization rounds");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
-      check_parameter(fit == "least squares" || fit == "monotone", "Absorbing boundary/Updating vector fit",
-                      fit, "least squares or monotone");
+      check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
+                        fit == "stabilized",
+                      "Absorbing boundary/Updating vector fit", fit,
+                      "least squares, monotone, bounded or stabilized");
+      check_parameter(l1_excess >= 0., "Absorbing boundary/Updating vector l1 excess", l1_excess, ">= 0");
     }
 
 
@@ -275,6 +337,9 @@ namespace PeriDEAL
       cloud_start.assign(1, 0);
       cloud_index.clear();
       update_vector.clear();
+      update_ls.clear();
+      update_monotone.clear();
+      theta.clear();
       stats = CloudStatistics();
 
       // Delta k and its bound (4.33): D Delta k^2 dt < 1.
@@ -371,19 +436,23 @@ namespace PeriDEAL
           // for equality constraints), then normalized exactly.
           Eigen::RowVectorXd V;
           const bool         monotone = prm.fit == "monotone";
-          if (!monotone)
+          if (prm.fit == "least squares" || prm.fit == "stabilized")
             V = psi_dt * cod.pseudoInverse();
+          else if (monotone)
+            V = bounded_fit(M, psi_dt, 0., -1.);
           else
+            V = bounded_fit(M, psi_dt, prm.l1_excess, prm.lower_bound);
+          if (prm.fit == "stabilized")
             {
-              const double    weight = 1e4 * std::sqrt(double(n_modes));
-              Eigen::MatrixXd A(n_modes + 1, cloud.size());
-              Eigen::VectorXd b(n_modes + 1);
-              A.topRows(n_modes) = M.transpose();
-              b.head(n_modes)    = psi_dt.transpose();
-              A.row(n_modes).setConstant(weight);
-              b[n_modes] = weight;
-              const Eigen::VectorXd v = nonnegative_least_squares(A, b);
-              V                       = v.transpose() / v.sum();
+              // Start from least squares; the monotone fit is the fallback
+              // the blend moves to.
+              const Eigen::RowVectorXd Vm = bounded_fit(M, psi_dt, 0., -1.);
+              for (unsigned int j = 0; j < cloud.size(); ++j)
+                {
+                  update_ls.push_back(V[j]);
+                  update_monotone.push_back(Vm[j]);
+                }
+              theta.push_back(0.);
             }
 
           // Condition number over the retained singular values.
@@ -400,7 +469,8 @@ namespace PeriDEAL
           // That is sufficient only: stable least-squares runs reach 2.1
           // (2D disc), so the guard is off by default and the PD near field
           // checks the one-step map itself (PdUnboundedDiffusion).
-          const bool l1_ok = monotone || vl1 <= prm.max_update_l1;
+          // (The stabilized fit applies the l1 bound as a cap on its blend.)
+          const bool l1_ok = monotone || prm.fit == "stabilized" || vl1 <= prm.max_update_l1;
           if (!(cond <= prm.max_condition_number) || !(vmax <= prm.max_update_norm) || !l1_ok)
             {
               std::ostringstream v;
@@ -436,6 +506,17 @@ namespace PeriDEAL
       stats.max_fit_residual     = Utilities::MPI::max(stats.max_fit_residual, comm);
       stats.min_cloud_size       = Utilities::MPI::min(min_size, comm);
       stats.max_cloud_size       = Utilities::MPI::max(max_size, comm);
+    }
+
+    template <int dim>
+    void
+    EbfDiffusionAbc<dim>::set_blend(const unsigned int a, const double th)
+    {
+      Assert(!theta.empty(), ExcMessage("set_blend needs the stabilized fit"));
+      AssertIndexRange(a, absorbing.size());
+      theta[a] = th;
+      for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+        update_vector[c] = (1. - th) * update_ls[c] + th * update_monotone[c];
     }
 
     template <int dim>

@@ -21,6 +21,7 @@
 #include <check.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 
@@ -482,6 +483,11 @@ namespace
     types::global_dof_index n_nodes = 0, n_absorbing = 0;
     /** Clouds with points owned by another rank. */
     unsigned int n_straddling = 0;
+    /** The ABC's cloud statistics and the setup's one-step growth. */
+    Abc::CloudStatistics stats;
+    double               growth = 0.;
+    /** Per absorbing cloud (this rank): sum_j V_j and the blend theta. */
+    std::vector<double> sum_v, theta;
   };
 
   /**
@@ -521,6 +527,16 @@ namespace
             break;
           }
     r.n_straddling = Utilities::MPI::sum(r.n_straddling, comm);
+    r.stats        = abc.statistics();
+    r.growth       = run.stability_growth;
+    for (unsigned int a = 0; a < abc.absorbing_points().size(); ++a)
+      {
+        double sum = 0.;
+        for (const auto &[j, v] : abc.cloud(a))
+          sum += v;
+        r.sum_v.push_back(sum);
+        r.theta.push_back(abc.blend(a));
+      }
     double previous = run.energy(region);
     r.energy.push_back(previous);
     r.solid.push_back(run.solid_volume());
@@ -646,6 +662,35 @@ namespace
       one_m = run_monotone(MPI_COMM_SELF);
     check_close(all_m.energy.back(), Utilities::MPI::broadcast(MPI_COMM_WORLD, one_m.energy.back(), 0), 1e-12,
                 "2D corrosion, monotone fit: Pi at t = 0.001, ranks vs 1 rank");
+
+    // The stabilized fit on the lattice sphere of sphere_truncation (its
+    // blend is decided by power iterations with global norms): the same
+    // clouds blended and the same Pi after 100 steps on all ranks vs 1.
+    LatticeParameters lp3;
+    lp3.dx    = 0.1;
+    lp3.delta = 0.2;
+    auto ap3              = e10_abc(lp3.delta);
+    ap3.wave_number_range = 0.;
+    ap3.fit               = "stabilized";
+    ShapeIndicator<3> c3([](const Point<3> &x) { return x.norm() <= 0.5; }, 1.);
+    const auto        run_sphere = [&](const MPI_Comm comm) {
+      return corrosion_record<3>(1., 0.8, lp3, e10_model(), ap3, c3, 1e-5, 100, 100,
+                                 Abc::TruncationBoundary::absorbing, comm);
+    };
+    const CorrosionRecord all_s = run_sphere(MPI_COMM_WORLD);
+    CorrosionRecord       one_s = all_s;
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      one_s = run_sphere(MPI_COMM_SELF);
+    if (root())
+      std::cout << "  3D sphere, stabilized fit: " << all_s.stats.n_blended << " clouds blended in "
+                << all_s.stats.stabilization_rounds << " rounds" << std::endl;
+    check(all_s.stats.n_blended > 0 &&
+            all_s.stats.n_blended ==
+              Utilities::MPI::broadcast(MPI_COMM_WORLD, one_s.stats.n_blended, 0) &&
+            all_s.stats.max_blend == Utilities::MPI::broadcast(MPI_COMM_WORLD, one_s.stats.max_blend, 0),
+          "3D sphere, stabilized fit: the same clouds blended on all ranks as on 1 rank");
+    check_close(all_s.energy.back(), Utilities::MPI::broadcast(MPI_COMM_WORLD, one_s.energy.back(), 0), 1e-12,
+                "3D sphere, stabilized fit: Pi at t = 0.001, ranks vs 1 rank");
   }
 
   // 1D PD diffusion of C0 = exp(-4x^2) on the real line has the
@@ -817,7 +862,7 @@ namespace
    * solid volume.
    */
   template <int dim>
-  void
+  CorrosionRecord
   corrosion_case(const CorrosionCase &c, const LatticeParameters &lp, const DiffusionModelParameters &model,
                  const Abc::EbfParameters &ap, const Function<dim> &c0)
   {
@@ -856,6 +901,7 @@ namespace
             "x closer to the reference than Neumann at t_end (ratio " +
             sci(dn.first / da_final.first) + ")");
     check(abc.monotone, name + "near-field energy non-increasing every step (Fig. 4.16)");
+    return abc;
   }
 
   void
@@ -972,16 +1018,98 @@ namespace
                   << run.stability_growth << std::endl;
       check(min_v >= 0. && max_sum_error < 1e-12, "monotone fit: V_j >= 0 and sum_j V_j = 1 in every cloud");
     }
+    // The stabilized fit: least squares except on the clouds of the
+    // growing modes, blended toward the monotone fit until the power
+    // iteration of the one-step map decays.
     // R_ref = 2: the run ends before the solid's concentration (gone at t =
     // 0.00275) reaches it, exp(-1.5^2 / (4 D_liq t_end)) = 0.08 of the
-    // front; it is the reference for Omega_N = |x| <= 0.8 only. Measured
-    // with the monotone fit: max Delta Pi/Pi0 7.5e-3 (the ABC under-absorbs
-    // late: Pi/Pi0 0.028 vs 0.020 at t_end), Neumann 4.6e-2 at t_end, gain
-    // 6.1. Asserted: 1e-2 over the run, gain >= 5; the radius-10 dx sphere
-    // is half absorbing layer (2,060 of 4,169 nodes).
-    CorrosionCase c{1., 2., dt, 0.005, 25, 1e-2, 1e-3};
-    c.required_gain = 5.;
-    corrosion_case<3>(c, lp, e10_model(), ap, c0);
+    // front; it is the reference for Omega_N = |x| <= 0.8 only. Measured:
+    // monotone fit max Delta Pi/Pi0 7.4e-3 (the ABC under-absorbs late:
+    // Pi/Pi0 0.028 vs 0.020 at t_end), Neumann 4.5e-2 at t_end, gain 6.1;
+    // stabilized fit (9 rounds, 751 of 2,060 clouds blended, growth 0.9988)
+    // max 3.8e-3, final 1.4e-3, gain 32.6. Asserted: 5e-3 over the run and
+    // the gain >= 10 of the issue; the radius-10 dx sphere is half absorbing
+    // layer (2,060 of 4,169 nodes).
+    ap.fit = "stabilized";
+    CorrosionCase c{1., 2., dt, 0.005, 25, 5e-3, 1e-3};
+    const auto    abc = corrosion_case<3>(c, lp, e10_model(), ap, c0);
+    double        max_theta_error = 0.;
+    for (const double th : abc.theta)
+      max_theta_error = std::max(max_theta_error, th < 0. ? -th : (th > 1. ? th - 1. : 0.));
+    max_theta_error = Utilities::MPI::max(max_theta_error, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "  stabilized fit: " << abc.stats.n_blended << " of " << abc.stats.n_absorbing
+                << " clouds blended (max theta " << abc.stats.max_blend << ") in "
+                << abc.stats.stabilization_rounds << " rounds, max sum |V_j| " << abc.stats.max_update_l1
+                << ", one-step growth " << abc.growth << std::endl;
+    check(abc.growth <= 1. && max_theta_error == 0.,
+          "stabilized fit: one-step growth <= 1 and blend theta in [0, 1]");
+    // Least squares where it is stable: the blend must be local, not the
+    // monotone fit everywhere.
+    check(abc.stats.n_blended > 0 && abc.stats.n_blended < abc.stats.n_absorbing / 2,
+          "stabilized fit: the blend acts on some, fewer than half, of the clouds");
+  }
+
+  double
+  env(const char *name, const double fallback)
+  {
+    return std::getenv(name) ? std::atof(std::getenv(name)) : fallback;
+  }
+
+  /**
+   * Exploration (not a ctest): the reduced sphere of sphere_truncation with
+   * the fit and mode set from the environment (SPHERE_FIT, SPHERE_L1,
+   * SPHERE_LB, SPHERE_DK, SPHERE_NK, SPHERE_NDIR, SPHERE_DINF in dx).
+   */
+  void
+  sphere_scan()
+  {
+    LatticeParameters lp;
+    lp.dx    = env("SPHERE_DX", 0.1);
+    lp.delta = 2. * lp.dx;
+    const double      R = env("SPHERE_R", 1.), scale = std::pow(0.2 / lp.delta, 3);
+    ShapeIndicator<3> c0([R](const Point<3> &x) { return x.norm() <= 0.5 * R; }, 1.);
+    auto              model = e10_model();
+    model.kappa_liquid *= scale;
+    model.kappa_interface *= scale;
+    auto ap                  = e10_abc(lp.delta);
+    ap.stability_check_steps = env("SPHERE_STEPS", ap.stability_check_steps);
+    ap.wave_number_range = env("SPHERE_DK", 0.);
+    ap.fit               = std::getenv("SPHERE_FIT") ? std::getenv("SPHERE_FIT") : "stabilized";
+    ap.l1_excess         = env("SPHERE_L1", ap.l1_excess);
+    ap.lower_bound       = env("SPHERE_LB", ap.lower_bound);
+    ap.n_wave_numbers    = env("SPHERE_NK", ap.n_wave_numbers);
+    ap.n_directions      = env("SPHERE_NDIR", ap.n_directions);
+    ap.cloud_radius      = env("SPHERE_DINF", 2.) * lp.dx * (1. + 1e-9);
+    ap.max_update_norm   = 1e10;
+    const double dt      = env("SPHERE_DT", 1e-5);
+    {
+      BallDomain<3>                ball(Point<3>(), R);
+      Abc::PdUnboundedDiffusion<3> run(MPI_COMM_WORLD);
+      const auto                   start = std::chrono::steady_clock::now();
+      try
+        {
+          run.setup(ball, lp, model, dt, Abc::TruncationBoundary::absorbing, ap, c0);
+        }
+      catch (const ParameterError &e)
+        {
+          if (root())
+            std::cout << "  setup: " << e.what() << std::endl;
+          return;
+        }
+      const auto &st = run.absorbing_boundary().statistics();
+      if (root())
+        std::cout << "  fit " << ap.fit << ": growth " << run.stability_growth << ", max sum|V| "
+                  << st.max_update_l1 << ", max |V| " << st.max_update_norm << ", residual "
+                  << st.max_fit_residual << ", blended " << st.n_blended << " of " << st.n_absorbing
+                  << " (max theta " << st.max_blend << ", " << st.stabilization_rounds << " rounds), setup "
+                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+                  << " s" << std::endl;
+    }
+    if (env("SPHERE_SETUP_ONLY", 0.) > 0.)
+      return;
+    CorrosionCase c{R, 2. * R, dt, env("SPHERE_T", 0.005), 25, 1e-2, 1e-3};
+    corrosion_case<3>(c, lp, model, ap, c0);
   }
 
   // 3D PD diffusion of C0 = exp(-4|x|^2) (J_1, D = 1, delta = 2 dx) on
@@ -1042,5 +1170,6 @@ main(int argc, char **argv)
               {"corrosion_2d", corrosion_2d},
               {"corrosion_3d", corrosion_3d},
               {"pd_3d", pd_3d},
-              {"sphere_truncation", sphere_truncation}});
+              {"sphere_truncation", sphere_truncation},
+              {"sphere_scan", sphere_scan}});
 }

@@ -57,6 +57,22 @@ namespace PeriDEAL
        */
       std::string fit = "least squares";
       /**
+       * "bounded" fit: least squares with sum_j V_j = 1 and
+       * sum_j |V_j| <= 1 + l1_excess (0 gives the monotone fit; the bound
+       * limits the negative weights that extrapolation needs).
+       */
+      double l1_excess = 0.5;
+      /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
+      double lower_bound = -1.;
+      /**
+       * "stabilized" fit (PD near field): V = (1 - theta) V_ls + theta V_mono
+       * per cloud, theta = 0 (least squares) except on the clouds that carry
+       * a growing mode of the one-step map, found by the setup's power
+       * iteration, where theta moves halfway to 1 per round. At most this
+       * many rounds.
+       */
+      unsigned int max_stabilization_rounds = 60;
+      /**
        * Optional guard for the least-squares fit: largest admissible
        * sum_j |V_j| (the infinity norm of an absorbing row of the one-step
        * map; <= 1 is sufficient for stability, not necessary: off by
@@ -129,6 +145,10 @@ namespace PeriDEAL
       double max_update_l1 = 0.;
       /** Largest relative residual |V M_G - Psi(dt)| / |Psi(dt)| of the fit. */
       double max_fit_residual = 0.;
+      /** "stabilized" fit: clouds with theta > 0, the largest theta, rounds. */
+      types::global_dof_index n_blended = 0;
+      double                  max_blend = 0.;
+      unsigned int            stabilization_rounds = 0;
       /** Delta k used and the bound (4.33) 1/sqrt(D dt). */
       double wave_number_range = 0., wave_number_bound = 0.;
     };
@@ -192,6 +212,24 @@ namespace PeriDEAL
       /** Cloud (local indices) and updating vector of absorbing point a. */
       std::vector<std::pair<unsigned int, double>>
       cloud(const unsigned int a) const;
+      /**
+       * "stabilized" fit: set the blend theta of cloud a, V = (1 - theta)
+       * V_ls + theta V_mono (the statistics' blend fields are the caller's).
+       */
+      void
+      set_blend(const unsigned int a, const double theta);
+      /** The blend theta of cloud a (0 unless "stabilized"). */
+      double
+      blend(const unsigned int a) const
+      {
+        return theta.empty() ? 0. : theta[a];
+      }
+      /** Statistics of all clouds. */
+      CloudStatistics &
+      statistics()
+      {
+        return stats;
+      }
       /** Statistics of all clouds. */
       const CloudStatistics &
       statistics() const
@@ -214,6 +252,8 @@ namespace PeriDEAL
       std::vector<unsigned int> cloud_start;
       std::vector<unsigned int> cloud_index;
       std::vector<double>       update_vector;
+      /** "stabilized" fit: the two fits and the blend per cloud. */
+      std::vector<double>       update_ls, update_monotone, theta;
       CloudStatistics           stats;
     };
   } // namespace Abc

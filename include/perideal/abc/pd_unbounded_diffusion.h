@@ -142,6 +142,31 @@ namespace PeriDEAL
       void
       check_stability(const unsigned int n_steps);
 
+      /**
+       * The "stabilized" fit: rounds of @p n_steps of power iteration from a
+       * random start on the nodes @p in_clouds (near the boundary); while
+       * the map grows, the clouds carrying the growing vector move halfway
+       * from least squares to the monotone fit. Before that, clouds with
+       * sum_j |V_j| > @p l1_cap are blended until they are below it.
+       */
+      void
+      stabilize(const unsigned int       n_steps,
+                const unsigned int       max_rounds,
+                const std::vector<bool> &in_clouds,
+                const double             l1_cap);
+
+      /**
+       * @p n_steps of the one-step map on @p u (normalized every step,
+       * ghosts updated at the end); returns the growth per step over the
+       * last quarter.
+       */
+      double
+      power_iteration(Vector &u, const unsigned int n_steps) const;
+
+      /** The pseudo-random start keyed by node id (rank independent). */
+      void
+      random_vector(Vector &u) const;
+
       Discretization<dim>                   disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       EbfDiffusionAbc<dim>                  abc;
