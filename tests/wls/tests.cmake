@@ -16,3 +16,12 @@ if(TARGET step-9)
     ${CMAKE_SOURCE_DIR}/tutorial/step-9/step-9.prm LABELS "tutorial;convergence;long"
     TIMEOUT 7200)
 endif()
+
+# WLS for the linearized LPS model, the PD scalar wave equation and backward
+# Euler diffusion (issue 5): one executable.
+perideal_add_test_program(wls_ext_tests ${CMAKE_CURRENT_LIST_DIR}/wls_ext_tests.cc)
+foreach(_t lps_rows lps_polynomial)
+  perideal_add_test(NAME wls.ext.${_t} COMMAND $<TARGET_FILE:wls_ext_tests> ${_t} LABELS unit)
+endforeach()
+perideal_add_test(NAME wls.ext.lps_polynomial.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:wls_ext_tests> lps_polynomial LABELS "unit;mpi")
