@@ -271,6 +271,96 @@ namespace PeriDEAL
     return rows;
   }
 
+  template <int dim>
+  std::vector<double>
+  vector_operator_rows(const double              constant,
+                       const InfluenceFunction   omega,
+                       const double              delta,
+                       const MonomialBasis<dim> &basis)
+  {
+    const unsigned int  np = basis.size();
+    std::vector<double> rows(dim * np, 0.);
+    for (unsigned int a = 0; a < dim; ++a)
+      for (unsigned int al = 1; al < np; ++al)
+        {
+          // omega xi_a xi^alpha: radial power |alpha| + 1 + dim - 1.
+          auto e = basis.exponents(al);
+          ++e[a];
+          const double ang = sphere_monomial_integral<dim>(e);
+          if (ang != 0.)
+            rows[a * np + al] =
+              constant * ang * radial_power_integral(omega, delta, basis.degree_of(al) + dim);
+        }
+    return rows;
+  }
+
+  template <int dim>
+  std::vector<double>
+  pair_tensor_operator_rows(const double              constant,
+                            const InfluenceFunction   omega,
+                            const double              delta,
+                            const double              s,
+                            const MonomialBasis<dim> &basis)
+  {
+    const unsigned int  np = basis.size();
+    std::vector<double> rows(dim * dim * np, 0.);
+    for (unsigned int a = 0; a < dim; ++a)
+      for (unsigned int b = 0; b < dim; ++b)
+        for (unsigned int al = 1; al < np; ++al)
+          {
+            // omega xi_a xi_b / r^s xi^alpha: radial power |alpha| + 2 - s + dim - 1.
+            auto e = basis.exponents(al);
+            ++e[a];
+            ++e[b];
+            const double ang = sphere_monomial_integral<dim>(e);
+            if (ang != 0.)
+              rows[(a * dim + b) * np + al] =
+                constant * ang *
+                radial_power_integral(omega, delta, basis.degree_of(al) + 1. - s + dim);
+          }
+    return rows;
+  }
+
+  template <int dim>
+  double
+  lps_weighted_volume(const InfluenceFunction omega, const double delta)
+  {
+    return sphere_monomial_integral<dim>(std::array<unsigned int, dim>{}) *
+           radial_power_integral(omega, delta, dim + 1.);
+  }
+
+  template <int dim>
+  std::vector<double>
+  lps_deviatoric_moment_matrix(const InfluenceFunction   omega,
+                               const double              delta,
+                               const MonomialBasis<dim> &basis)
+  {
+    const unsigned int np = basis.size(), n = dim * np;
+    const auto         theta_row =
+      vector_operator_rows<dim>(dim / lps_weighted_volume<dim>(omega, delta), omega, delta, basis);
+    std::vector<double> M(n * n, 0.), p(np), p0(np), phi(n);
+    basis.evaluate(Tensor<1, dim>(), 1., p0.data());
+    // The integrand is a polynomial in r of degree <= 2 order + dim + 2:
+    // Gauss on [0, delta] is exact.
+    const QGauss<1> qr(basis.order() + dim / 2 + 3);
+    for (unsigned int q = 0; q < qr.size(); ++q)
+      {
+        const double r = delta * qr.point(q)[0], wr = delta * qr.weight(q);
+        const double w = influence(omega, r, delta) * std::pow(r, dim - 1.) * wr;
+        for (const auto &[nv, wa] : angular_rule<dim>())
+          {
+            basis.evaluate(r * nv, 1., p.data());
+            for (unsigned int a = 0; a < dim; ++a)
+              for (unsigned int al = 0; al < np; ++al)
+                phi[a * np + al] = nv[a] * (p[al] - p0[al]) - r * theta_row[a * np + al] / dim;
+            for (unsigned int x = 0; x < n; ++x)
+              for (unsigned int y = 0; y < n; ++y)
+                M[x * n + y] += w * wa * phi[x] * phi[y];
+          }
+      }
+    return M;
+  }
+
   double
   wls_weight_function(const double r, const double r_bar)
   {
@@ -305,6 +395,7 @@ namespace PeriDEAL
   {
     init_auxiliary_grid();
     op_row = scalar_operator_row<dim>(kernel, basis);
+    shapes = {{1u, 1u}};
   }
 
   template <int dim>
@@ -319,6 +410,35 @@ namespace PeriDEAL
   {
     init_auxiliary_grid();
     op_row = bond_based_operator_rows<dim>(micromodulus, omega, delta, basis);
+    shapes = {{dim, dim}};
+  }
+
+  template <int dim>
+  WlsQuadrature<dim>::WlsQuadrature(const WlsParameters            &parameters_in,
+                                    const double                    delta_in,
+                                    const std::vector<WlsOperator> &operators)
+    : parameters(parameters_in)
+    , basis(order_supported(dim, parameters_in.order) ? parameters_in.order : 2)
+    , components(operators.empty() ? 1 : operators[0].n_out)
+    , delta(delta_in)
+  {
+    init_auxiliary_grid();
+    AssertThrow(!operators.empty(), ExcMessage("WlsQuadrature: no operator given"));
+    for (unsigned int k = 0; k < operators.size(); ++k)
+      {
+        const auto &o = operators[k];
+        AssertThrow(o.n_out > 0 && o.n_in > 0 &&
+                      o.rows.size() == std::size_t(o.n_out) * o.n_in * basis.size(),
+                    ExcMessage("WlsOperator " + std::to_string(k) + ": rows must hold n_out x "
+                               "n_in x n_p = " + std::to_string(o.n_out * o.n_in * basis.size()) +
+                               " entries (the basis of the given WLS order)"));
+        shapes.emplace_back(o.n_out, o.n_in);
+        if (k == 0)
+          op_row = o.rows;
+        else
+          extra_row.push_back(o.rows);
+      }
+    extra_weight.resize(extra_row.size());
   }
 
   template <int dim>
@@ -377,14 +497,19 @@ namespace PeriDEAL
                             const std::vector<std::int32_t>  &family,
                             const std::vector<unsigned int>  &rows)
   {
-    const unsigned int np = basis.size(), nc = n_colloc, c2 = components * components;
+    const unsigned int np = basis.size(), nc = n_colloc;
     node = rows;
     row_start.assign(1, 0);
     col.clear();
     weight.clear();
     condition_number.clear();
     col.reserve(rows.size() * nc);
-    weight.reserve(rows.size() * nc * c2);
+    weight.reserve(rows.size() * nc * shapes[0].first * shapes[0].second);
+    for (unsigned int k = 1; k < shapes.size(); ++k)
+      {
+        extra_weight[k - 1].clear();
+        extra_weight[k - 1].reserve(rows.size() * nc * shapes[k].first * shapes[k].second);
+      }
 
     std::vector<unsigned int>  cand;
     std::vector<char>          used;
@@ -481,15 +606,20 @@ namespace PeriDEAL
         for (unsigned int a = 0; a < np; ++a)
           scale[a] = std::pow(r_bar, -double(basis.degree_of(a)));
         for (unsigned int c = 0; c < nc; ++c)
+          col.push_back(chosen[c]);
+        for (unsigned int k = 0; k < shapes.size(); ++k)
           {
-            col.push_back(chosen[c]);
-            for (unsigned int ab = 0; ab < c2; ++ab)
-              {
-                double w = 0.;
-                for (unsigned int a = 0; a < np; ++a)
-                  w += op_row[ab * np + a] * scale[a] * Q(a, c);
-                weight.push_back(w);
-              }
+            const std::vector<double> &L   = k == 0 ? op_row : extra_row[k - 1];
+            std::vector<double>       &out = k == 0 ? weight : extra_weight[k - 1];
+            const unsigned int         nab = shapes[k].first * shapes[k].second;
+            for (unsigned int c = 0; c < nc; ++c)
+              for (unsigned int ab = 0; ab < nab; ++ab)
+                {
+                  double w = 0.;
+                  for (unsigned int a = 0; a < np; ++a)
+                    w += L[ab * np + a] * scale[a] * Q(a, c);
+                  out.push_back(w);
+                }
           }
         row_start.push_back(col.size());
       }
@@ -604,6 +734,14 @@ namespace PeriDEAL
                                                                   const MonomialBasis<dim> &); \
   template std::vector<double> bond_based_operator_rows<dim>(                                  \
     const double, const InfluenceFunction, const double, const MonomialBasis<dim> &);          \
+  template std::vector<double> vector_operator_rows<dim>(                                      \
+    const double, const InfluenceFunction, const double, const MonomialBasis<dim> &);          \
+  template std::vector<double> pair_tensor_operator_rows<dim>(                                 \
+    const double, const InfluenceFunction, const double, const double,                         \
+    const MonomialBasis<dim> &);                                                               \
+  template double              lps_weighted_volume<dim>(const InfluenceFunction, const double); \
+  template std::vector<double> lps_deviatoric_moment_matrix<dim>(                              \
+    const InfluenceFunction, const double, const MonomialBasis<dim> &);                        \
   template void build_node_families<dim>(const std::vector<Point<dim>> &, const double,        \
                                          std::vector<std::uint64_t> &,                         \
                                          std::vector<std::int32_t> &);

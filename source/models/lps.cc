@@ -65,6 +65,7 @@ namespace PeriDEAL
     : disc(discretization)
     , K_d(dim == 3 ? p.bulk_modulus : p.bulk_modulus + p.shear_modulus / 3.)
     , G(p.shear_modulus)
+    , omega_in_use(p.omega)
     , s0(p.critical_stretch > 0. ? p.critical_stretch :
          p.fracture_energy > 0.  ? lps_critical_stretch(dim, p.omega, discretization.parameters().delta,
                                                         dim == 3 ? p.bulk_modulus :
@@ -122,6 +123,17 @@ namespace PeriDEAL
       ud[d] = u[d].begin();
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
+        if (!wls_row.empty() && wls_row[i] >= 0)
+          {
+            // theta_i = L_theta Q-bar_i U-bar_i: dim weights per collocation node.
+            const auto &w = wls->weights(0);
+            double      s = 0.;
+            for (auto e = wls->row_start[wls_row[i]]; e < wls->row_start[wls_row[i] + 1]; ++e)
+              for (unsigned int d = 0; d < dim; ++d)
+                s += w[e * dim + d] * ud[d][wls->col[e]];
+            th.local_element(i) = s;
+            continue;
+          }
         const std::uint64_t begin = nb.row_start[i];
         const double       *coef  = bond_coefficient.data() + nb.table_start[i];
         double              s     = 0.;
@@ -162,6 +174,27 @@ namespace PeriDEAL
 
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
+        if (!wls_force.empty() && wls_force[i])
+          {
+            // (3.51): L_I Q_i Theta_i + L_J Q-bar_i U-bar_i.
+            const auto  &wI = wls->weights(1);
+            const auto  &wJ = wls->weights(2);
+            const int    k  = wls_row[i];
+            double       f[dim] = {};
+            for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+              {
+                const std::int32_t j = wls->col[e];
+                for (unsigned int a = 0; a < dim; ++a)
+                  {
+                    f[a] += wI[e * dim + a] * td[j];
+                    for (unsigned int b = 0; b < dim; ++b)
+                      f[a] += wJ[(e * dim + a) * dim + b] * ud[b][j];
+                  }
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(i) = f[d];
+            continue;
+          }
         const std::uint64_t begin = nb.row_start[i];
         const double       *coef  = bond_coefficient.data() + nb.table_start[i];
         const double        inv_mi = md[i] > 0. ? 1. / md[i] : 0.;
@@ -201,6 +234,26 @@ namespace PeriDEAL
     const auto &x  = disc.position;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
+        if (!wls_force.empty() && wls_force[i])
+          {
+            // (2.14) on the fitted polynomial: K_d theta^2/2 + alpha/2 c^T M c,
+            // c_(a alpha) = sum_j N_alpha,j u_a,j the fit coefficients.
+            const auto        &N  = wls->weights(3);
+            const unsigned int np = wls->n_basis(), n = dim * np;
+            const int          k  = wls_row[i];
+            std::vector<double> c(n, 0.);
+            for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+              for (unsigned int a = 0; a < dim; ++a)
+                for (unsigned int al = 0; al < np; ++al)
+                  c[a * np + al] += N[e * np + al] * u[a].local_element(wls->col[e]);
+            double dev = 0.;
+            for (unsigned int x = 0; x < n; ++x)
+              for (unsigned int y = 0; y < n; ++y)
+                dev += c[x] * wls_dev_moment[x * n + y] * c[y];
+            const double ti    = th.local_element(i);
+            W.local_element(i) = 0.5 * K_d * ti * ti + 0.5 * wls_alpha * dev;
+            continue;
+          }
         const std::uint64_t begin = nb.row_start[i];
         const double       *coef  = bond_coefficient.data() + nb.table_start[i];
         const double        ti    = th.local_element(i);
@@ -302,8 +355,35 @@ namespace PeriDEAL
     const double a_vol = std::abs(dim * K_d - (dim + 2.) * G);
     const double a_dev = dim * (dim + 2.) * G;
     double       bound = 0.;
+    if (wls)
+      {
+        // WLS rows: |K_il| <= |W^J_il| + sum_j |W^I_ij| |d theta_j/d u_l|, so
+        // the Gershgorin row sum is at most sum_e |W^J_e| + |W^I_e| S_col(e).
+        Vector S;
+        disc.initialize_vector(S);
+        dilatation_sensitivity(S);
+        S.update_ghost_values();
+        const auto &wI = wls->weights(1);
+        const auto &wJ = wls->weights(2);
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (wls_force[i])
+            for (unsigned int a = 0; a < dim; ++a)
+              {
+                double s = 0.;
+                for (auto e = wls->row_start[wls_row[i]]; e < wls->row_start[wls_row[i] + 1];
+                     ++e)
+                  {
+                    s += std::abs(wI[e * dim + a]) * S.local_element(wls->col[e]);
+                    for (unsigned int b = 0; b < dim; ++b)
+                      s += std::abs(wJ[(e * dim + a) * dim + b]);
+                  }
+                bound = std::max(bound, s);
+              }
+      }
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
+        if (!wls_force.empty() && wls_force[i])
+          continue;
         const double *coef   = bond_coefficient.data() + nb.table_start[i];
         const double  inv_mi = m.local_element(i) > 0. ? 1. / m.local_element(i) : 0.;
         for (unsigned int a = 0; a < dim; ++a)
@@ -331,6 +411,84 @@ namespace PeriDEAL
       }
     bound = Utilities::MPI::max(bound, disc.get_mpi_communicator());
     return bound > 0. ? 2. * std::sqrt(rho / bound) : std::numeric_limits<double>::infinity();
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::dilatation_sensitivity(Vector &S) const
+  {
+    const auto &nb = disc.neighborhood;
+    const auto &x  = disc.position;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        double s = 0.;
+        if (!wls_row.empty() && wls_row[i] >= 0)
+          {
+            const auto &w = wls->weights(0);
+            for (auto e = wls->row_start[wls_row[i]]; e < wls->row_start[wls_row[i] + 1]; ++e)
+              for (unsigned int d = 0; d < dim; ++d)
+                s += std::abs(w[e * dim + d]);
+          }
+        else
+          {
+            // d/m_i sum_j w_ij xi . (u_j - u_i): l1 norm 2 d/m_i sum_j w_ij |xi|_1.
+            const double *coef = bond_coefficient.data() + nb.table_start[i];
+            for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+              for (unsigned int d = 0; d < dim; ++d)
+                s += 2. * coef[b - nb.row_start[i]] * std::abs(x[nb.col[b]][d] - x[i][d]);
+            const double mi = m.local_element(i);
+            s               = mi > 0. ? dim * s / mi : 0.;
+          }
+        S.local_element(i) = s;
+      }
+  }
+
+  template <int dim>
+  void
+  LinearizedLPSOperator<dim>::set_wls_rows(const WlsParameters             &parameters,
+                                           const std::vector<unsigned int> &rows)
+  {
+    check_parameter(!std::isfinite(s0), "Model/Critical stretch", s0,
+                    "0 and Fracture energy 0 with the WLS quadrature (WLS rows have no bonds "
+                    "to break)");
+    const double delta = disc.parameters().delta;
+    const auto   omega = omega_in_use;
+    const double mbar  = lps_weighted_volume<dim>(omega, delta);
+    const MonomialBasis<dim> basis(parameters.order);
+    const unsigned int       np = basis.size();
+    std::vector<WlsOperator> ops(4);
+    ops[0] = {1, dim, vector_operator_rows<dim>(dim / mbar, omega, delta, basis)};
+    ops[1] = {dim, 1, vector_operator_rows<dim>((dim * K_d - (dim + 2.) * G) / mbar, omega,
+                                                delta, basis)};
+    ops[2] = {dim, dim,
+              pair_tensor_operator_rows<dim>(2. * dim * (dim + 2.) * G / mbar, omega, delta, 2.,
+                                             basis)};
+    ops[3] = {np, 1, std::vector<double>(np * np, 0.)};
+    for (unsigned int a = 0; a < np; ++a)
+      ops[3].rows[a * np + a] = 1.;
+    wls = std::make_unique<WlsQuadrature<dim>>(parameters, delta, ops);
+    wls_dev_moment = lps_deviatoric_moment_matrix<dim>(omega, delta, basis);
+    wls_alpha      = dim * (dim + 2.) * G / mbar;
+
+    // Force rows, and theta rows: the force rows and every owned node
+    // with enough family nodes for a fit.
+    const auto &nb = disc.neighborhood;
+    wls_force.assign(disc.n_owned(), 0);
+    for (const unsigned int i : rows)
+      {
+        AssertThrow(i < disc.n_owned() && disc.region[i] == Discretization<dim>::interior,
+                    ExcMessage("WLS rows must be owned interior nodes."));
+        wls_force[i] = 1;
+      }
+    std::vector<unsigned int> theta_rows;
+    wls_row.assign(disc.n_owned(), -1);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (wls_force[i] || nb.row_start[i + 1] - nb.row_start[i] + 1 >= wls->n_collocation())
+        {
+          wls_row[i] = theta_rows.size();
+          theta_rows.push_back(i);
+        }
+    wls->build(disc.position, nb.row_start, nb.col, theta_rows);
   }
 
   template <int dim>

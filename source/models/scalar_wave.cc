@@ -42,6 +42,42 @@ namespace PeriDEAL
     }
   } // namespace
 
+  void
+  ScalarWaveParameters::declare_parameters(ParameterHandler &prm)
+  {
+    prm.declare_entry("Influence function", "constant", Patterns::Selection("constant|linear"),
+                      "omega_0 = 1 (2.12) or omega_1 = 1 - r/delta (2.13).");
+    prm.declare_entry("Kernel exponent", "2", Patterns::Double(),
+                      "p of |xi|^-p in (2.40) (< n_d + 2).");
+    prm.declare_entry("Wave speed", "1", Patterns::Double(), "chi (> 0).");
+    prm.declare_entry("Micro-modulus", "0", Patterns::Double(),
+                      "c_s (>= 0); 0: calibrated from the wave speed.");
+    prm.declare_entry("Damping", "0", Patterns::Double(), "d (>= 0) of (2.40).");
+    prm.declare_entry("Time step", "0", Patterns::Double(),
+                      "dt (> 0, at most the critical step of the undamped scheme).");
+    prm.declare_entry("Quadrature", "standard", Patterns::Selection("standard|wls"),
+                      "standard scheme (3.3) or the WLS collocation quadrature (Sect. 3.2) "
+                      "on every interior node.");
+    prm.enter_subsection("WLS");
+    WlsParameters::declare_parameters(prm);
+    prm.leave_subsection();
+  }
+
+  void
+  ScalarWaveParameters::parse_parameters(ParameterHandler &prm)
+  {
+    omega          = parse_influence_function(prm.get("Influence function"), "Influence function");
+    exponent       = prm.get_double("Kernel exponent");
+    wave_speed     = prm.get_double("Wave speed");
+    micro_constant = prm.get_double("Micro-modulus");
+    damping        = prm.get_double("Damping");
+    time_step      = prm.get_double("Time step");
+    quadrature     = prm.get("Quadrature");
+    prm.enter_subsection("WLS");
+    wls.parse_parameters(prm);
+    prm.leave_subsection();
+  }
+
   template <int dim>
   ScalarWaveSolver<dim>::ScalarWaveSolver(const Discretization<dim>  &discretization,
                                           const ScalarWaveParameters &p)
@@ -55,6 +91,17 @@ namespace PeriDEAL
     const ScalarKernel &k = op.kernel();
     for (std::size_t e = 0; e < bond_kernel_weight.size(); ++e)
       bond_kernel_weight[e] = k(std::min(nb.bond_length[e], k.delta)) * nb.bond_weight[e];
+
+    check_parameter(p.quadrature == "standard" || p.quadrature == "wls", "Quadrature",
+                    p.quadrature, "standard|wls");
+    if (p.quadrature == "wls")
+      {
+        std::vector<unsigned int> rows;
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (disc.region[i] == Discretization<dim>::interior)
+            rows.push_back(i);
+        op.set_wls_rows(p.wls, rows);
+      }
 
     const double dt_crit = critical_time_step();
     check_parameter(dt > 0. && dt <= dt_crit, "Time stepping/Time step", dt,
@@ -180,6 +227,17 @@ namespace PeriDEAL
     const auto   &nb = disc.neighborhood;
     const double *u  = displacement.begin();
     double        e  = 0.;
+    if (op.wls_quadrature() != nullptr)
+      {
+        // -1/2 u . M L u: L u of the current u (ghosts of u up to date).
+        Vector lu;
+        disc.initialize_vector(lu);
+        op.apply(displacement, lu);
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (disc.region[i] == Discretization<dim>::interior)
+            e -= 0.5 * u[i] * lu.local_element(i) * disc.volume[i];
+        return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+      }
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         if (disc.region[i] != Discretization<dim>::interior)

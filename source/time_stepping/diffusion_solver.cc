@@ -76,9 +76,10 @@ namespace PeriDEAL
                       "collocation quadrature (Sect. 3.2) on every interior node. hybrid: "
                       "the fixed hybrid configuration of Sect. 3.3, standard scheme on "
                       "Omega_s (see 'Standard region width' and 'Standard region'), WLS "
-                      "elsewhere. Non-standard choices need forward Euler; with corrosion a "
-                      "WLS row falls back to the standard one where its collocation nodes "
-                      "are of mixed phase.");
+                      "elsewhere. With backward Euler the WLS rows enter the Jacobian "
+                      "(non-symmetric: GMRES) for linear diffusion; corrosion with WLS needs "
+                      "forward Euler, and a WLS row falls back to the standard one where its "
+                      "collocation nodes are of mixed phase.");
     prm.declare_entry("Standard region width", "0", Patterns::Double(),
                       "hybrid: interior nodes closer than this (>= 0) to the boundary of "
                       "the body (signed distance of the geometry) use the standard "
@@ -164,8 +165,11 @@ namespace PeriDEAL
     p.leave_subsection();
     check_parameter(standard_width >= 0., "Hybrid/Standard region width", standard_width,
                     "a non-negative number");
-    check_parameter(quadrature == "standard" || scheme == "forward Euler", "Hybrid/Quadrature",
-                    quadrature, "standard with backward Euler (the WLS rows are explicit only)");
+    check_parameter(quadrature == "standard" || scheme == "forward Euler" ||
+                      model.type == "diffusion",
+                    "Hybrid/Quadrature", quadrature,
+                    "standard for corrosion with backward Euler (the phase-dependent WLS "
+                    "rows are explicit only)");
 
     p.enter_subsection("Output");
     output_directory     = p.get("Directory");
@@ -334,6 +338,36 @@ namespace PeriDEAL
 
   template <int dim>
   void
+  DiffusionSolver<dim>::replace_wls_rows()
+  {
+    // Row i of I/dt - L becomes 1/dt - w_ii on the diagonal and -w_ij for
+    // the interior collocation nodes; the standard row's entries are zeroed
+    // first. The collocation nodes are family nodes, so every entry is in
+    // the pattern assemble_backward_euler() built (interior family).
+    const auto *wls = op->wls_quadrature();
+    if (wls == nullptr)
+      return;
+    const auto &part = *disc.partitioner();
+    for (unsigned int k = 0; k < wls->node.size(); ++k)
+      {
+        const unsigned int            i   = wls->node[k];
+        const types::global_dof_index row = part.local_to_global(i);
+        for (auto it = matrix.begin(row); it != matrix.end(row); ++it)
+          it->value() = 0.;
+        for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+          {
+            const unsigned int j = wls->col[e];
+            if (disc.region[j] != Discretization<dim>::interior)
+              continue;
+            const double v = (j == i ? 1. / dt : 0.) - wls->weight[e];
+            matrix.set(row, part.local_to_global(j), v);
+          }
+      }
+    matrix.compress(VectorOperation::insert);
+  }
+
+  template <int dim>
+  void
   DiffusionSolver<dim>::apply_dirichlet(Vector &v, const double t)
   {
     dirichlet_function.set_time(t);
@@ -388,6 +422,7 @@ namespace PeriDEAL
     if (!matrix_valid)
       {
         op->assemble_backward_euler(dt, matrix, &phase);
+        replace_wls_rows();
         use_amg = prm.preconditioner == "AMG" ||
                   (prm.preconditioner == "auto" && dt > 10. * dt_critical);
         if (use_amg)
@@ -423,6 +458,19 @@ namespace PeriDEAL
             (has_source ? source_function.value(disc.position[i]) : 0.) :
           C_new.local_element(i);
     op->add_constrained_coupling(C_new, b, &phase);
+    if (const auto *wls = op->wls_quadrature())
+      // WLS rows: C^n/dt + S + sum over prescribed collocation nodes w_ij C_j
+      // (add_constrained_coupling() added the standard row's couplings).
+      for (unsigned int k = 0; k < wls->node.size(); ++k)
+        {
+          const unsigned int i = wls->node[k];
+          double             s = C.local_element(i) / dt +
+                     (has_source ? source_function.value(disc.position[i]) : 0.);
+          for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+            if (disc.region[wls->col[e]] != Discretization<dim>::interior)
+              s += wls->weight[e] * C_new.local_element(wls->col[e]);
+          b.local_element(i) = s;
+        }
 
     // Trilinos vectors hold the owned range in the same order.
     std::copy(b.begin(), b.begin() + disc.n_owned(), rhs.begin());
@@ -446,7 +494,7 @@ namespace PeriDEAL
         const TrilinosWrappers::PreconditionBase &preconditioner =
           use_amg ? static_cast<const TrilinosWrappers::PreconditionBase &>(amg) :
                     static_cast<const TrilinosWrappers::PreconditionBase &>(jacobi);
-        if (op->is_corrosion())
+        if (op->is_corrosion() || n_wls_global > 0)
           {
             TrilinosWrappers::SolverGMRES solver(control);
             solver.solve(matrix, delta_c, residual, preconditioner);

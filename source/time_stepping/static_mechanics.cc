@@ -2,6 +2,7 @@
 #include <deal.II/base/timer.h>
 
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 
@@ -92,6 +93,15 @@ namespace PeriDEAL
     prm.declare_entry("Tolerance", "1e-10", Patterns::Double(),
                       "CG: relative residual reduction (0 < tol < 1).");
     prm.declare_entry("Max iterations", "10000", Patterns::Integer(1), "CG iteration limit.");
+    prm.declare_entry("Quadrature", "standard", Patterns::Selection("standard|wls"),
+                      "standard scheme, or the WLS collocation quadrature (Sect. 3.2, "
+                      "(3.32)-(3.51)) on every free interior node (Model = LPS); the "
+                      "non-symmetric system is then solved matrix-free with GMRES, "
+                      "preconditioned by the Solver's factorization (AMG or direct) of "
+                      "the standard-scheme stiffness.");
+    prm.enter_subsection("WLS");
+    WlsParameters::declare_parameters(prm);
+    prm.leave_subsection();
     prm.leave_subsection();
   }
 
@@ -129,6 +139,12 @@ namespace PeriDEAL
     max_iterations = p.get_integer("Max iterations");
     check_parameter(tolerance > 0. && tolerance < 1., "Static mechanics/Tolerance", tolerance,
                     "0 < tolerance < 1");
+    quadrature = p.get("Quadrature");
+    p.enter_subsection("WLS");
+    wls.parse_parameters(p);
+    p.leave_subsection();
+    check_parameter(quadrature == "standard" || model == "LPS", "Static mechanics/Quadrature",
+                    quadrature, "standard for Model = linearized bond-based (WLS: Model = LPS)");
     p.leave_subsection();
 
     p.enter_subsection("Model");
@@ -215,6 +231,18 @@ namespace PeriDEAL
                     "a constraint layer or node set that removes the rigid-body modes");
     for (auto &c : u)
       disc.initialize_vector(c);
+
+    check_parameter(prm.quadrature == "standard" || (prm.quadrature == "wls" && lps),
+                    "Static mechanics/Quadrature", prm.quadrature,
+                    "standard, or wls with Model = LPS");
+    if (prm.quadrature == "wls")
+      {
+        std::vector<unsigned int> rows;
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (disc.region[i] == Discretization<dim>::interior && !fixed[i])
+            rows.push_back(i);
+        lps->set_wls_rows(prm.wls, rows);
+      }
   }
 
   template <int dim>
@@ -273,6 +301,80 @@ namespace PeriDEAL
     Stiffness::to_dofs(disc, uc, x);
 
     SolverControl control(prm.max_iterations, prm.tolerance * rhs.l2_norm());
+    if (lps && lps->wls_quadrature())
+      {
+        // Matrix-free K x: fixed rows identity, fixed columns dropped, the
+        // free rows -f(x with the fixed entries zeroed); GMRES preconditioned
+        // with the standard-scheme stiffness K (same continuum operator).
+        VectorField xf, fx;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            disc.initialize_vector(xf[d]);
+            disc.initialize_vector(fx[d]);
+          }
+        struct WlsSystem
+        {
+          std::function<void(TrilinosWrappers::MPI::Vector &, const TrilinosWrappers::MPI::Vector &)>
+            apply;
+          void
+          vmult(TrilinosWrappers::MPI::Vector &dst, const TrilinosWrappers::MPI::Vector &src) const
+          {
+            apply(dst, src);
+          }
+        } system;
+        system.apply = [&](TrilinosWrappers::MPI::Vector       &dst,
+                           const TrilinosWrappers::MPI::Vector &src) {
+          Stiffness::from_dofs(disc, src, xf);
+          for (unsigned int i = 0; i < disc.n_owned() + disc.n_ghost(); ++i)
+            if (fixed[i])
+              for (unsigned int d = 0; d < dim; ++d)
+                xf[d].local_element(i) = 0.;
+          compute_forces(xf, fx);
+          for (unsigned int i = 0; i < disc.n_owned(); ++i)
+            for (unsigned int d = 0; d < dim; ++d)
+              fx[d].local_element(i) =
+                fixed[i] ? src[dim * types::global_dof_index(disc.partitioner()->local_to_global(i)) + d] :
+                           -fx[d].local_element(i);
+          Stiffness::to_dofs(disc, fx, dst);
+        };
+        SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData gmres_data(300);
+        SolverGMRES<TrilinosWrappers::MPI::Vector> gmres(control, gmres_data);
+        if (prm.solver == "direct")
+          {
+            // The factorization of K as preconditioner.
+            SolverControl                  inner(1, 0.);
+            TrilinosWrappers::SolverDirect direct(inner);
+            direct.initialize(K);
+            struct Direct
+            {
+              TrilinosWrappers::SolverDirect *solver;
+              void
+              vmult(TrilinosWrappers::MPI::Vector &dst, const TrilinosWrappers::MPI::Vector &src) const
+              {
+                solver->solve(dst, src);
+              }
+            } prec{&direct};
+            gmres.solve(system, x, rhs, prec);
+          }
+        else
+          {
+            TrilinosWrappers::PreconditionAMG                 amg;
+            TrilinosWrappers::PreconditionAMG::AdditionalData data;
+            data.elliptic = true;
+            data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
+            for (unsigned int k = 0; k < owned.n_elements(); ++k)
+              data.constant_modes[k % dim][k] = true;
+            amg.initialize(K, data);
+            gmres.solve(system, x, rhs, amg);
+          }
+        iterations = control.last_step();
+        system.vmult(res, x);
+        res -= rhs;
+        residual = res.l2_norm() / std::max(rhs.l2_norm(), std::numeric_limits<double>::min());
+        Stiffness::from_dofs(disc, x, u);
+        solve_seconds = timer.wall_time();
+        return;
+      }
     if (prm.solver == "direct")
       {
         TrilinosWrappers::SolverDirect direct(control);

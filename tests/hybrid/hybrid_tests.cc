@@ -406,7 +406,7 @@ namespace
     const std::string base = e2_parameters(10, 0.001, "");
     expect([&] { parameters_from_text<DiffusionRunParameters<2>>(base + "subsection Hybrid\n set Quadrature = hybrid\n set Standard region width = -1\nend\n"); },
            "Standard region width");
-    expect([&] { parameters_from_text<DiffusionRunParameters<2>>(base + "subsection Hybrid\n set Quadrature = wls\nend\nsubsection Time stepping\n set Scheme = backward Euler\nend\n"); },
+    expect([&] { parameters_from_text<DiffusionRunParameters<2>>(base + "subsection Model\n set Type = corrosion\nend\nsubsection Hybrid\n set Quadrature = wls\nend\nsubsection Time stepping\n set Scheme = backward Euler\nend\n"); },
            "Quadrature");
   }
 } // namespace

@@ -112,6 +112,77 @@ namespace PeriDEAL
                            const MonomialBasis<dim> &basis);
 
   /**
+   * Rows of the vector moment operator
+   * c int omega(|xi|) xi_a (p_alpha(xi) - p_alpha(0)) dV over the full ball,
+   * entry [a * n_p + alpha], in closed form. With c = d/m-bar it is the
+   * linearized dilatation L_theta of (3.35)-(3.39) (input component a, one
+   * output), with c = (d K_d - (d+2) G)/m-bar the operator L_I of
+   * (3.43)-(3.45) (output component a, one input: the p(0) term of (3.44)
+   * integrates to zero over the ball). m-bar = lps_weighted_volume().
+   */
+  template <int dim>
+  std::vector<double>
+  vector_operator_rows(const double              constant,
+                       const InfluenceFunction   omega,
+                       const double              delta,
+                       const MonomialBasis<dim> &basis);
+
+  /**
+   * Rows of the pair-tensor operator
+   * c int omega(|xi|) (xi (x) xi)/|xi|^s (u(x+xi) - u(x)) dV, entry
+   * [(a * dim + b) * n_p + alpha] as in bond_based_operator_rows() (which is
+   * s = 3, c the micromodulus). s = 2 with c = 2 d (d+2) G / m-bar is the
+   * operator L_J of the linearized LPS model, (3.46)-(3.50).
+   */
+  template <int dim>
+  std::vector<double>
+  pair_tensor_operator_rows(const double              constant,
+                            const InfluenceFunction   omega,
+                            const double              delta,
+                            const double              s,
+                            const MonomialBasis<dim> &basis);
+
+  /**
+   * The continuum weighted volume m-bar = int_{|xi| <= delta} omega |xi|^2 dV
+   * (2.15) in closed form.
+   */
+  template <int dim>
+  double
+  lps_weighted_volume(const InfluenceFunction omega, const double delta);
+
+  /**
+   * The n_p dim x n_p dim matrix M of the deviatoric LPS energy on the
+   * fitted polynomial: with the coefficients c_(a alpha) of the fit
+   * (component a, monomial alpha, unscaled basis), theta = L_theta c and
+   * M = int omega phi phi^T dV, phi_(a alpha)(xi) = n_a (p_alpha(xi) -
+   * p_alpha(0)) - |xi| (L_theta)_(a alpha) / d, so that
+   * int omega (e - theta |xi|/d)^2 dV = c^T M c (index a * n_p + alpha).
+   * By numerical quadrature (radial Gauss x angular rule, exact for these
+   * polynomials up to round-off).
+   */
+  template <int dim>
+  std::vector<double>
+  lps_deviatoric_moment_matrix(const InfluenceFunction   omega,
+                               const double              delta,
+                               const MonomialBasis<dim> &basis);
+
+  /**
+   * A linear functional of the fitted polynomial for WlsQuadrature's
+   * general constructor: n_out x n_in rows over the monomials,
+   * rows[(a * n_in + b) * n_p + alpha] the coefficient with which monomial
+   * alpha (unscaled basis p(xi)) of input component b enters output a. The
+   * quadrature weights are then a block of n_out x n_in per collocation
+   * node. Identity rows (n_out = n_p, n_in = 1, rows[alpha * n_p + beta] =
+   * delta_alpha,beta) give the fit coefficients N of (3.31) themselves.
+   */
+  struct WlsOperator
+  {
+    unsigned int        n_out = 1;
+    unsigned int        n_in  = 1;
+    std::vector<double> rows;
+  };
+
+  /**
    * The WLS weight function (3.26), written without overflow as
    * (exp(-16 r^2/rbar^2) - exp(-64)) / (1 - exp(-64)).
    */
@@ -179,6 +250,16 @@ namespace PeriDEAL
                   const double            delta);
 
     /**
+     * Several general operators on the same collocation sets (one fit per
+     * node, e.g. the dilatation, L_I and L_J of the linearized LPS model):
+     * operator k has operators[k].n_out x operators[k].n_in weights per
+     * collocation node, in weights(k); weights(0) is #weight.
+     * n_components() is operators[0].n_out. @p delta is the horizon.
+     */
+    WlsQuadrature(const WlsParameters &parameters, const double delta,
+                  const std::vector<WlsOperator> &operators);
+
+    /**
      * Compute the weights of the nodes @p rows. position holds all nodes
      * (local numbering); family_start/family is a CSR list of candidate
      * neighbours (not including the node itself) indexed by node, as in
@@ -241,6 +322,25 @@ namespace PeriDEAL
     std::vector<double> condition_number;
     /** @} */
 
+    /** Number of operators (1 for the scalar and bond-based constructors). */
+    unsigned int
+    n_operators() const
+    {
+      return 1 + extra_weight.size();
+    }
+    /** n_out x n_in of operator @p k. */
+    std::pair<unsigned int, unsigned int>
+    operator_shape(const unsigned int k) const
+    {
+      return {shapes[k].first, shapes[k].second};
+    }
+    /** Weights of operator @p k, n_out x n_in (row-major) per column entry. */
+    const std::vector<double> &
+    weights(const unsigned int k) const
+    {
+      return k == 0 ? weight : extra_weight[k - 1];
+    }
+
     /** Smallest and largest cond(A_i) over the (local) rows. */
     std::pair<double, double>
     condition_range() const;
@@ -273,6 +373,10 @@ namespace PeriDEAL
     /** Auxiliary grid offsets in units of delta / r_a, nearest first. */
     std::vector<Tensor<1, dim>> aux_offsets;
     std::vector<double>         op_row;
+    /** Operators 1, 2, ... of the general constructor and their weights. */
+    std::vector<std::vector<double>>                   extra_row;
+    std::vector<std::vector<double>>                   extra_weight;
+    std::vector<std::pair<unsigned int, unsigned int>> shapes;
 
     void
     init_auxiliary_grid();

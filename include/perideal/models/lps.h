@@ -5,9 +5,11 @@
 
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
+#include <perideal/discretization/wls_quadrature.h>
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace PeriDEAL
@@ -242,18 +244,74 @@ namespace PeriDEAL
     double
     total_strain_energy(const VectorField &u) const;
 
+    /**
+     * Meshfree WLS collocation quadrature of the linearized LPS model
+     * (dissertation Sect. 3.2, (3.32)-(3.51), with the errata of the
+     * catalog: the 3/m-bar of (3.36) kept, L_I in the first term of (3.51)).
+     * The owned interior nodes @p rows compute their force from one WLS fit
+     * per node with the continuum weighted volume m-bar (2.15) of the full
+     * ball:
+     *   f_i = L_I Q_i Theta_i + L_J Q-bar_i U-bar_i,
+     * L_I = ((d K_d - (d+2) G)/m-bar) int omega xi p(xi) dV and
+     * L_J = (2 d (d+2) G/m-bar) int omega (xi (x) xi)/|xi|^2 (p(xi) - p(0)) dV
+     * (in 3D (3.45) and (3.50): (3K - 5G)/3 and 6G times the selection
+     * patterns). Theta_i holds the dilatations of the collocation nodes,
+     * theta_j = L_theta Q-bar_j U-bar_j with L_theta = (d/m-bar) int omega
+     * xi^T (p(xi) - p(0)) dV ((3.35)-(3.39)), computed by WLS on every owned
+     * node whose family holds at least n_c nodes (also the
+     * volume-constraint layer, with one-sided fits, so that an interior
+     * node's Theta_i is exact for polynomial fields), by the standard sum
+     * (2.19) on the others. WLS-k is then exact for polynomial displacements
+     * of degree <= k: the force equals the continuum LPS operator, for
+     * quadratics the Navier operator (K_d + (d-2) G/d) grad div u + G Laplace u. strain_energy_density()
+     * of a WLS row integrates (2.14) on the fitted polynomial in closed form
+     * (lps_deviatoric_moment_matrix()), so a homogeneous deformation gives
+     * the CCM energy density exactly. Needs critical stretch 0 (no bond
+     * breaking: a WLS row has no bonds); the other rows keep the standard
+     * scheme (the fixed hybrid configuration of Sect. 3.3). Collective.
+     */
+    void
+    set_wls_rows(const WlsParameters &parameters, const std::vector<unsigned int> &rows);
+
+    /** The WLS quadrature (dilatation, L_I, L_J, fit coefficients), or nullptr. */
+    const WlsQuadrature<dim> *
+    wls_quadrature() const
+    {
+      return wls.get();
+    }
+
+    /** True if owned node @p i computes its force by WLS. */
+    bool
+    is_wls_force_row(const unsigned int i) const
+    {
+      return !wls_force.empty() && wls_force[i];
+    }
+
   private:
     /** Break the owned-row bonds whose linearized stretch exceeds s0. */
     void
     break_bonds(const VectorField &u);
 
     const Discretization<dim> &disc;
-    double                     K_d, G, s0;
+    double                     K_d, G;
+    InfluenceFunction          omega_in_use;
+    double                     s0;
     /** omega(min(|xi|, delta)) beta V_j per table entry. */
     std::vector<double> bond_coefficient;
     Vector              m;
     Vector              theta;
     std::vector<std::uint8_t> broken_flag;
+    /** WLS: the quadrature, its row per owned node (-1: standard theta) and the force rows. */
+    std::unique_ptr<WlsQuadrature<dim>> wls;
+    std::vector<int>                    wls_row;
+    std::vector<unsigned char>          wls_force;
+    /** lps_deviatoric_moment_matrix() and alpha = d (d+2) G / m-bar. */
+    std::vector<double> wls_dev_moment;
+    double              wls_alpha = 0.;
+
+    /** l1 norm of d theta_i / d u of the owned nodes (critical_time_step()). */
+    void
+    dilatation_sensitivity(Vector &S) const;
   };
 } // namespace PeriDEAL
 

@@ -2,12 +2,14 @@
 #define perideal_models_scalar_wave_h
 
 #include <deal.II/base/function.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/models/diffusion.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace PeriDEAL
@@ -34,6 +36,25 @@ namespace PeriDEAL
     double damping = 0.;
     /** Time step; must not exceed critical_time_step() (else ParameterError). */
     double time_step = 0.;
+    /**
+     * "standard": the standard scheme (3.3); "wls": the meshfree WLS
+     * collocation quadrature (Sect. 3.2) on every interior node (the
+     * DiffusionOperator's WLS rows with the kernel c_s omega/r^p).
+     */
+    std::string quadrature = "standard";
+    /** Order and collocation nodes of the WLS quadrature. */
+    WlsParameters wls;
+
+    /**
+     * Declare "Influence function", "Kernel exponent", "Wave speed",
+     * "Micro-modulus", "Damping", "Time step", "Quadrature" and the
+     * subsection "WLS" (the caller has entered its subsection).
+     */
+    static void
+    declare_parameters(ParameterHandler &prm);
+    /** Read and validate them. */
+    void
+    parse_parameters(ParameterHandler &prm);
   };
 
   /**
@@ -117,7 +138,11 @@ namespace PeriDEAL
     /**
      * 1/4 sum_{i interior} sum_j k(|xi_ij|) (u_j - u_i)^2 beta V_j V_i
      * (all ranks). Needs up-to-date ghosts of u (true after initialize()
-     * and advance()).
+     * and advance()). With the WLS quadrature (no bonds) the quadratic form
+     * -1/2 sum_{i interior} u_i (L u)_i V_i of the discrete operator, which
+     * velocity Verlet conserves up to O(dt^2) oscillations when M L is
+     * symmetric (every interior row with the same collocation stencil, i.e.
+     * a uniform lattice with a volume-constraint layer of width delta).
      */
     double
     potential_energy() const;

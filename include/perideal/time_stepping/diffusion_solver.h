@@ -55,7 +55,8 @@ namespace PeriDEAL
      * 3.3): "standard" everywhere, "wls" (WLS collocation on every interior
      * node) or "hybrid" (fixed Omega_s = interior nodes within
      * standard_width of the boundary or where standard_region > 0, WLS
-     * elsewhere). Forward Euler only.
+     * elsewhere). Forward Euler, or backward Euler for linear diffusion (the
+     * WLS rows in the Jacobian, solved with GMRES).
      */
     std::string   quadrature      = "standard";
     WlsParameters wls;
@@ -210,6 +211,9 @@ namespace PeriDEAL
   private:
     void
     setup_quadrature();
+    /** Backward Euler with WLS rows: their rows of the matrix become I/dt - w. */
+    void
+    replace_wls_rows();
     void
     explicit_step();
     void

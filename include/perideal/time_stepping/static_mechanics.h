@@ -49,6 +49,9 @@ namespace PeriDEAL
     std::string  solver = "cg-amg";
     double       tolerance = 1e-10;
     unsigned int max_iterations = 10000;
+    /** "standard" or "wls" (LPS only: LinearizedLPSOperator::set_wls_rows() on the free interior nodes). */
+    std::string   quadrature = "standard";
+    WlsParameters wls;
     /** Output directory; empty: no files. */
     std::string output_directory;
 
@@ -111,6 +114,12 @@ namespace PeriDEAL
     displacement() const
     {
       return u;
+    }
+    /** The LPS operator (Model = LPS, after setup()), else nullptr. */
+    const LinearizedLPSOperator<dim> *
+    lps_operator() const
+    {
+      return lps.get();
     }
     /** Nonzero for prescribed nodes (owned and ghost entries). */
     const std::vector<unsigned char> &
