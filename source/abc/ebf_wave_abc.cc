@@ -59,6 +59,16 @@ namespace PeriDEAL
                         "mean of the nodes in each auxiliary cell (filters the shortest lattice waves).");
       prm.declare_entry("Cloud points", "all", Patterns::Selection("all|interior"),
                         "PD: all points of the cone (the source) or only non-absorbing ones.");
+      prm.declare_entry("Lattice modes", "none", Patterns::Selection("none|corner|zone"),
+                        "Mesh-scale standing modes added to the mode set: none (the source), the "
+                        "Brillouin-zone corner, or corner and face centres.");
+      prm.declare_entry("Lattice mode damping", "0", Patterns::Double(0.),
+                        "Extra decay rate of the lattice modes.");
+      prm.declare_entry("Layer filter", "0", Patterns::Double(0., 0.25),
+                        "eps of the lattice-Laplacian viscosity added to the updating vectors "
+                        "(eps sum over the nearest nodes of (u_j - u_i)^n - (u_j - u_i)^{n-1}; 0: the source).");
+      prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order"),
+                        "The EBF extrapolation (4.82) or the conventional first-order ABC (4.75).");
       prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
                         "Setup throws ParameterError if the checked spectral radius exceeds this.");
     }
@@ -82,6 +92,10 @@ namespace PeriDEAL
       max_spectral_radius      = prm.get_double("Maximum spectral radius");
       cloud_points             = prm.get("Cloud points");
       thinning                 = prm.get("Thinning");
+      lattice_modes            = prm.get("Lattice modes");
+      lattice_mode_damping     = prm.get_double("Lattice mode damping");
+      layer_filter             = prm.get_double("Layer filter");
+      method                   = prm.get("Method");
     }
 
 
@@ -303,6 +317,23 @@ namespace PeriDEAL
           phi.push_back(prm.direction_range * (-1. + 2. * l / prm.n_directions));
       const unsigned int n_modes = k.size() * phi.size();
       stats.n_modes              = n_modes;
+      // Zone-boundary wave vectors of the near-field lattice (global frame):
+      // corner (pi/dx, ..., pi/dx) and the face centres (pi/dx e_d).
+      std::vector<Tensor<1, dim>> lattice_wave_vectors;
+      if (prm.lattice_modes == "corner" || prm.lattice_modes == "zone")
+        {
+          Tensor<1, dim> K;
+          for (unsigned int d = 0; d < dim; ++d)
+            K[d] = M_PI / dx;
+          lattice_wave_vectors.push_back(K);
+        }
+      if (prm.lattice_modes == "zone" && dim > 1)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            Tensor<1, dim> K;
+            K[d] = M_PI / dx;
+            lattice_wave_vectors.push_back(K);
+          }
 
       const double r = prm.cloud_radius;
       std::map<std::array<long, dim>, std::vector<unsigned int>> bins;
@@ -321,6 +352,12 @@ namespace PeriDEAL
       // x bar < 0 and |y bar| < cot(Delta phi) |x bar|.
       const double cone_slope = 1. / std::tan(std::max(prm.cone_angle, 1e-12));
 
+      // Long-wave speed of the relation (first-order ABC).
+      Tensor<1, dim> e_long;
+      e_long[0]        = 1e-4;
+      const double chi = std::sqrt(dispersion.symbol(e_long)) / 1e-4;
+      check_parameter(prm.method == "ebf" || prm.method == "first order", "Absorbing boundary/Method",
+                      prm.method, "ebf or first order");
       double       max_cond = 0., max_norm = 0.;
       unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
       unsigned int n_thinned = 0, max_stride = 1;
@@ -338,18 +375,42 @@ namespace PeriDEAL
                 dir_local[l][dim - 1] = std::sin(phi[l]);
               dir_global[l] = transpose(R) * dir_local[l];
             }
-          std::vector<std::complex<double>> omega(n_modes);
+          // Every mode: wave vector in the local frame, complex frequency and
+          // decay rate; psi = exp(-decay t + i K.x bar - i omega t).
+          std::vector<Tensor<1, dim>>       kvec;
+          std::vector<std::complex<double>> omega;
+          std::vector<double>               decay;
           for (unsigned int l = 0; l < phi.size(); ++l)
             for (unsigned int m = 0; m < k.size(); ++m)
-              omega[l * k.size() + m] = dispersion.frequency(k[m], dir_global[l]);
-          const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int l,
-                                const unsigned int m) {
+              {
+                kvec.push_back(k[m] * dir_local[l]);
+                omega.push_back(dispersion.frequency(k[m], dir_global[l]));
+                decay.push_back(dispersion.damping);
+              }
+          // Lattice (mesh-scale) modes: standing waves exp(i K.x) cos(omega t)
+          // with K on the Brillouin-zone boundary (global frame), omega from
+          // the dispersion relation, decaying by the extra rate.
+          for (const auto &K : lattice_wave_vectors)
+            {
+              const double w2 = dispersion.symbol(K) - dispersion.damping * dispersion.damping;
+              const std::complex<double> w = std::sqrt(std::complex<double>(w2, 0.));
+              for (const double sgn : {1., -1.})
+                {
+                  kvec.push_back(R * K);
+                  omega.push_back(sgn * w);
+                  decay.push_back(dispersion.damping + prm.lattice_mode_damping);
+                  kvec.push_back(-(R * K));
+                  omega.push_back(-sgn * std::conj(w));
+                  decay.push_back(dispersion.damping + prm.lattice_mode_damping);
+                }
+            }
+          const unsigned int n_all = kvec.size();
+          const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int c) {
             const std::complex<double> I(0., 1.);
-            return std::exp(-dispersion.damping * time + I * k[m] * (dir_local[l] * xbar) -
-                            I * omega[l * k.size() + m] * time);
+            return std::exp(-decay[c] * time + I * (kvec[c] * xbar) - I * omega[c] * time);
           };
-          const auto mode_rate = [&](const unsigned int l, const unsigned int m) {
-            return -dispersion.damping - std::complex<double>(0., 1.) * omega[l * k.size() + m];
+          const auto mode_rate = [&](const unsigned int c) {
+            return -decay[c] - std::complex<double>(0., 1.) * omega[c];
           };
 
           // Candidates: x_i and the points of the cone within d_inf.
@@ -380,6 +441,47 @@ namespace PeriDEAL
           std::sort(cone.begin() + 1, cone.end(), [&ids](const auto &p, const auto &q) {
             return ids[p.first] < ids[q.first];
           });
+
+          if (prm.method == "first order")
+            {
+              // (4.75) by forward Euler: u^{n+1} = (1 - d dt) u^n - chi dt du/dn,
+              // du/dn (= d/dx bar) from a linear least-squares fit over x_i
+              // and the cone points within min(d_inf, 2 dx) (upwind).
+              std::vector<unsigned int> sel{0};
+              for (unsigned int c = 1; c < cone.size(); ++c)
+                if (cone[c].second.norm() <= std::min(r, 2. * dx) * (1. + 1e-10))
+                  sel.push_back(c);
+              Eigen::MatrixXd A(sel.size(), dim + 1);
+              for (unsigned int q = 0; q < sel.size(); ++q)
+                {
+                  A(q, 0) = 1.;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    A(q, d + 1) = cone[sel[q]].second[d];
+                }
+              const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+              check_parameter(cod.rank() == dim + 1, "Absorbing boundary/Cloud radius", r,
+                              "a radius whose cone behind absorbing node " + std::to_string(ids[i]) +
+                                " holds enough points for a linear fit (first-order ABC)");
+              const Eigen::MatrixXd P = cod.pseudoInverse();
+              WaveCloudInfo         ci;
+              for (unsigned int q = 0; q < sel.size(); ++q)
+                {
+                  const double c = -dt * chi * P(1, q) + (q == 0 ? 1. - dt * dispersion.damping : 0.);
+                  cloud_index.push_back(cone[sel[q]].first);
+                  vg_now.push_back(c);
+                  vg_old.push_back(0.);
+                  vh_now.push_back(c);
+                  vh_old.push_back(0.);
+                  ci.vmax_g = ci.vmax_h = std::max(ci.vmax_g, std::abs(c));
+                  ci.row_sum_g += std::abs(c);
+                }
+              cloud_start.push_back(cloud_index.size());
+              info.push_back(ci);
+              max_norm = std::max(max_norm, ci.vmax_g);
+              min_size = std::min<unsigned int>(min_size, sel.size());
+              max_size = std::max<unsigned int>(max_size, sel.size());
+              continue;
+            }
 
           std::ostringstream name;
           name << "absorbing node " << ids[i] << " at (" << xi << ")";
@@ -468,27 +570,25 @@ namespace PeriDEAL
                 break;
               // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt)
               // (block means of the modes for averaged entries).
-              CMatrix MG(2 * cloud.size(), n_modes), MH(2 * cloud.size(), n_modes);
-              CRow    psi_g(n_modes), psi_h(n_modes);
-              for (unsigned int l = 0; l < phi.size(); ++l)
-                for (unsigned int m = 0; m < k.size(); ++m)
-                  {
-                    const unsigned int c = l * k.size() + m;
-                    psi_g[c]             = mode(Tensor<1, dim>(), dt, l, m);
-                    psi_h[c]             = mode_rate(l, m) * psi_g[c];
-                    for (unsigned int j = 0; j < cloud.size(); ++j)
-                      for (unsigned int s = 0; s < 2; ++s)
-                        {
-                          // One time level: the rows of level n-1 vanish
-                          // (their updating coefficients become 0).
-                          std::complex<double> value = 0.;
-                          if (s < prm.n_time_levels)
-                            for (const auto &q : members[j])
-                              value += q.second * mode(cone[q.first].second, -double(s) * dt, l, m);
-                          MG(2 * j + s, c) = value;
-                          MH(2 * j + s, c) = mode_rate(l, m) * MG(2 * j + s, c);
-                        }
-                  }
+              CMatrix MG(2 * cloud.size(), n_all), MH(2 * cloud.size(), n_all);
+              CRow    psi_g(n_all), psi_h(n_all);
+              for (unsigned int c = 0; c < n_all; ++c)
+                {
+                  psi_g[c] = mode(Tensor<1, dim>(), dt, c);
+                  psi_h[c] = mode_rate(c) * psi_g[c];
+                  for (unsigned int j = 0; j < cloud.size(); ++j)
+                    for (unsigned int s = 0; s < 2; ++s)
+                      {
+                        // One time level: the rows of level n-1 vanish
+                        // (their updating coefficients become 0).
+                        std::complex<double> value = 0.;
+                        if (s < prm.n_time_levels)
+                          for (const auto &q : members[j])
+                            value += q.second * mode(cone[q.first].second, -double(s) * dt, c);
+                        MG(2 * j + s, c) = value;
+                        MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
+                      }
+                }
               fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance);
               fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance);
               ok = fg.cond <= prm.max_condition_number && fh.cond <= prm.max_condition_number &&
@@ -538,6 +638,39 @@ namespace PeriDEAL
                 cf.second[2] += q.second * fh.V[2 * j];
                 cf.second[3] += q.second * fh.V[2 * j + 1];
               }
+          // Layer filter: + eps sum_{|x_j - x_i| <= dx} ((u_j - u_i)^n -
+          // (u_j - u_i)^{n-1}), a lattice-Laplacian viscosity acting on the
+          // time difference (a Laplacian of u^n itself would act as a
+          // stiffness in the two-level recursion, not as damping); it damps
+          // the mesh-scale waves (symbol up to 4 dim eps) and hardly the
+          // fitted ones ((k dx)^2 eps).
+          if (prm.layer_filter > 0.)
+            {
+              check_parameter(prm.n_time_levels == 2, "Absorbing boundary/Layer filter", prm.layer_filter,
+                              "0 with one time level (the filter acts on u^n - u^{n-1})");
+              const auto b0 = bin_of(xi);
+              for (unsigned int nb = 0; nb < (dim == 1 ? 3u : 9u); ++nb)
+                {
+                  auto         b = b0;
+                  unsigned int c = nb;
+                  for (unsigned int d = 0; d < dim; ++d, c /= 3)
+                    b[d] += long(c % 3) - 1;
+                  const auto it = bins.find(b);
+                  if (it == bins.end())
+                    continue;
+                  for (const unsigned int j : it->second)
+                    if (j != i && xi.distance(points[j]) <= dx * (1. + 1e-6))
+                      for (const auto &p : {std::make_pair(j, 1.), std::make_pair(i, -1.)})
+                        {
+                          auto &cf = coeff[ids[p.first]];
+                          cf.first = p.first;
+                          cf.second[0] += p.second * prm.layer_filter;
+                          cf.second[1] -= p.second * prm.layer_filter;
+                          cf.second[2] += p.second * prm.layer_filter;
+                          cf.second[3] -= p.second * prm.layer_filter;
+                        }
+                }
+            }
           // x_i first (as before), then by global id.
           std::vector<std::pair<unsigned int, std::array<double, 4>>> sorted_coeff{coeff[ids[i]]};
           for (const auto &cf : coeff)
@@ -621,12 +754,13 @@ namespace PeriDEAL
 
     template <int dim>
     void
-    PdUnboundedWave<dim>::setup(const Domain<dim>          &domain,
-                                const LatticeParameters    &lattice,
-                                const ScalarWaveParameters &model,
-                                const WaveTruncation        boundary,
-                                const WaveAbcParameters    &prm_in,
-                                const Function<dim>        &initial)
+    PdUnboundedWave<dim>::setup(const Domain<dim>                            &domain,
+                                const LatticeParameters                      &lattice,
+                                const ScalarWaveParameters                   &model,
+                                const WaveTruncation                          boundary,
+                                const WaveAbcParameters                      &prm_in,
+                                const Function<dim>                          &initial,
+                                const std::vector<std::array<Point<dim>, 2>> &notches)
     {
       check_parameter(domain.has_signed_distance(), "Geometry/Domain", "without signed distance",
                       "a box or a ball (the absorbing layer needs the distance to the boundary)");
@@ -667,16 +801,40 @@ namespace PeriDEAL
       for (std::size_t e = 0; e < bond_kernel_weight.size(); ++e)
         bond_kernel_weight[e] = kern(std::min(nb.bond_length[e], kern.delta)) * nb.bond_weight[e];
 
+      // Notches (Sect. 4.2.7): the bonds whose segment crosses one are broken.
+      broken.clear();
+      {
+        const auto side = [](const Point<dim> &a, const Point<dim> &b, const Point<dim> &c) {
+          return dim == 1 ? c[0] - a[0] : (b[0] - a[0]) * (c[dim - 1] - a[dim - 1]) - (b[dim - 1] - a[dim - 1]) * (c[0] - a[0]);
+        };
+        const auto crosses = [&](const Point<dim> &p, const Point<dim> &q, const std::array<Point<dim>, 2> &n) {
+          if (dim == 1)
+            return side(n[0], n[1], p) * side(n[0], n[1], q) < 0.;
+          return side(n[0], n[1], p) * side(n[0], n[1], q) < 0. && side(p, q, n[0]) * side(p, q, n[1]) < 0.;
+        };
+        for (unsigned int i = 0; i < disc.n_owned() && !notches.empty(); ++i)
+          for (std::uint64_t q = nb.row_start[i]; q < nb.row_start[i + 1]; ++q)
+            {
+              const unsigned int j = nb.col[q];
+              for (const auto &n : notches)
+                if (crosses(disc.position[i], disc.position[j], n))
+                  {
+                    broken.emplace_back(i, j, bond_kernel_weight[nb.table_start[i] + (q - nb.row_start[i])]);
+                    break;
+                  }
+            }
+      }
+
       u.update_ghost_values();
       v.update_ghost_values();
-      op->apply(u, Lu);
+      apply_operator();
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         a.local_element(i) = Lu.local_element(i);
       const unsigned int n_local = disc.n_owned() + disc.n_ghost();
       u_old.assign(u.begin(), u.begin() + n_local);
       v_old.assign(v.begin(), v.begin() + n_local);
 
-      absorbing = boundary == WaveTruncation::absorbing;
+      absorbing = boundary != WaveTruncation::free;
       if (prm_in.dispersion == "local")
         relation = std::make_unique<WaveDispersion<dim>>(
           WaveDispersion<dim>::local(model.wave_speed, d));
@@ -689,6 +847,8 @@ namespace PeriDEAL
         return;
 
       WaveAbcParameters prm = prm_in;
+      if (boundary == WaveTruncation::first_order)
+        prm.method = "first order";
       const double      delta = lattice.delta;
       if (prm.cloud_radius <= 0.)
         prm.cloud_radius = delta;
@@ -764,7 +924,7 @@ namespace PeriDEAL
         uu[nodes[c]] = u_abc[c];
       t += dt;
       u.update_ghost_values();
-      op->apply(u, Lu);
+      apply_operator();
       const double  scale = 1. / (1. + dt * d);
       const double *lu    = Lu.begin();
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
@@ -815,7 +975,7 @@ namespace PeriDEAL
         v.update_ghost_values();
         // The acceleration of a consistent state (only read at nodes whose
         // v is not overwritten by the absorbing update).
-        op->apply(u, Lu);
+        apply_operator();
         for (unsigned int i = 0; i < n; ++i)
           a.local_element(i) = Lu.local_element(i) - 2. * d * v.local_element(i);
       };
@@ -968,6 +1128,24 @@ namespace PeriDEAL
     }
 
     template <int dim>
+    void
+    PdUnboundedWave<dim>::apply_operator()
+    {
+      op->apply(u, Lu);
+      const double *uu = u.begin();
+      double       *lu = Lu.begin();
+      for (const auto &[i, j, w] : broken)
+        lu[i] -= w * (uu[j] - uu[i]);
+    }
+
+    template <int dim>
+    std::uint64_t
+    PdUnboundedWave<dim>::n_broken_bonds() const
+    {
+      return Utilities::MPI::sum<std::uint64_t>(broken.size(), disc.get_mpi_communicator());
+    }
+
+    template <int dim>
     double
     PdUnboundedWave<dim>::energy(const std::function<bool(const Point<dim> &)> &inside) const
     {
@@ -988,6 +1166,9 @@ namespace PeriDEAL
           const double vi = v.local_element(i);
           e += (0.5 * vi * vi + 0.25 * row) * disc.volume[i];
         }
+      for (const auto &[i, j, w] : broken)
+        if (inside(disc.position[i]))
+          e -= 0.25 * w * (uu[j] - uu[i]) * (uu[j] - uu[i]) * disc.volume[i];
       return Utilities::MPI::sum(e, disc.get_mpi_communicator());
     }
 

@@ -15,7 +15,9 @@
 #include <perideal/models/diffusion.h>
 #include <perideal/models/scalar_wave.h>
 
+#include <array>
 #include <complex>
+#include <tuple>
 #include <functional>
 #include <memory>
 #include <string>
@@ -82,6 +84,32 @@ namespace PeriDEAL
        * waves onto smooth ones).
        */
       std::string thinning = "nearest";
+      /**
+       * Mesh-scale modes added to the mode set: "none" (the source),
+       * "corner" (standing waves at the Brillouin-zone corner
+       * K = (pi/dx, ..., pi/dx), the top of the PD lattice spectrum) or "zone"
+       * (corner and face centres pi/dx e_d), with the frequency of the
+       * dispersion relation, so that the extrapolation follows these
+       * non-propagating lattice waves instead of amplifying them.
+       */
+      std::string lattice_modes = "none";
+      /** Extra decay rate of the lattice modes (>= 0: the extrapolation damps them). */
+      double lattice_mode_damping = 0.;
+      /**
+       * eps of the layer filter: eps sum_j ((u_j - u_i)^n - (u_j - u_i)^{n-1})
+       * over the nodes within dx of x_i is added to u_i^{n+1} (and likewise
+       * to v), a lattice-Laplacian viscosity folded into V_G, V_H (0: the
+       * source; needs two time levels).
+       */
+      double layer_filter = 0.;
+      /**
+       * "ebf" (the EBF extrapolation (4.82)) or "first order": the
+       * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
+       * with du/dn from a least-squares linear fit over x_i and the cone
+       * points within min(d_inf, 2 dx) (same for v); chi is the long-wave
+       * speed of the dispersion relation.
+       */
+      std::string method = "ebf";
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -289,7 +317,14 @@ namespace PeriDEAL
       /** The EBF absorbing boundary. */
       absorbing,
       /** Nothing: a free PD surface (reflecting). Used for the extended reference. */
-      free
+      free,
+      /**
+       * The conventional first-order ABC (4.75), u_t + chi du/dn + d u = 0,
+       * on the same absorbing layer: forward Euler in time, du/dn by a
+       * least-squares linear fit over the cone behind the node (the
+       * baseline of Sect. 4.2.5).
+       */
+      first_order
     };
 
     /**
@@ -306,13 +341,22 @@ namespace PeriDEAL
     public:
       explicit PdUnboundedWave(const MPI_Comm comm);
 
+      /**
+       * @p notches (2D): segments (a, b); every bond crossing one is broken
+       * (Sect. 4.2.7), in the operator and in the energy.
+       */
       void
-      setup(const Domain<dim>          &domain,
-            const LatticeParameters    &lattice,
-            const ScalarWaveParameters &model,
-            const WaveTruncation        boundary,
-            const WaveAbcParameters    &abc,
-            const Function<dim>        &initial);
+      setup(const Domain<dim>                           &domain,
+            const LatticeParameters                     &lattice,
+            const ScalarWaveParameters                  &model,
+            const WaveTruncation                         boundary,
+            const WaveAbcParameters                     &abc,
+            const Function<dim>                         &initial,
+            const std::vector<std::array<Point<dim>, 2>> &notches = {});
+
+      /** Number of broken bonds of the owned rows (notches, all ranks). */
+      std::uint64_t
+      n_broken_bonds() const;
 
       /** One velocity-Verlet step with the absorbing update. */
       void
@@ -394,6 +438,9 @@ namespace PeriDEAL
       /** The dense one-step map (column-major, m x m) of one_step_spectral_radius(). */
       unsigned int
       assemble_one_step_map(const unsigned int max_size, std::vector<double> &map);
+      /** Lu = L u (u with current ghosts), minus the broken bonds. */
+      void
+      apply_operator();
 
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
@@ -402,6 +449,8 @@ namespace PeriDEAL
       Vector                                  u, v, a, Lu;
       std::vector<double>                     u_old, v_old, u_abc, v_abc;
       std::vector<double>                     bond_kernel_weight;
+      /** Broken bonds: owned row i, local column j, kernel weight. */
+      std::vector<std::tuple<unsigned int, unsigned int, double>> broken;
       double                                  dt = 0., t = 0., d = 0.;
       bool                                    absorbing = false;
     };
