@@ -6,6 +6,7 @@
 
 #include <perideal/abc/absorbing_layer.h>
 #include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/abc/spectral_radius.h>
 #include <perideal/base/exceptions.h>
 
 #include <Eigen/Dense>
@@ -23,6 +24,27 @@ namespace PeriDEAL
 {
   namespace Abc
   {
+    double
+    spectral_radius(dealii::LAPACKFullMatrix<double> &map,
+                    unsigned int                     *n_unstable,
+                    std::complex<double>             *dominant)
+    {
+      map.compute_eigenvalues(false, false);
+      double       rho  = 0.;
+      unsigned int n_up = 0;
+      for (unsigned int i = 0; i < map.m(); ++i)
+        {
+          const double mod = std::abs(map.eigenvalue(i));
+          if (mod > rho && dominant)
+            *dominant = map.eigenvalue(i);
+          rho = std::max(rho, mod);
+          n_up += mod > 1. + 1e-8 ? 1 : 0;
+        }
+      if (n_unstable)
+        *n_unstable = n_up;
+      return rho;
+    }
+
     void
     WaveAbcParameters::declare_parameters(ParameterHandler &prm)
     {
@@ -1025,20 +1047,7 @@ namespace PeriDEAL
       for (unsigned int col = 0; col < m; ++col)
         for (unsigned int i = 0; i < m; ++i)
           map(i, col) = dense[std::size_t(col) * m + i];
-      map.compute_eigenvalues(false, false);
-      double       rho = 0.;
-      unsigned int n_up = 0;
-      for (unsigned int i = 0; i < m; ++i)
-        {
-          const double mod = std::abs(map.eigenvalue(i));
-          if (mod > rho && dominant)
-            *dominant = map.eigenvalue(i);
-          rho = std::max(rho, mod);
-          n_up += mod > 1. + 1e-8 ? 1 : 0;
-        }
-      if (n_unstable)
-        *n_unstable = n_up;
-      return rho;
+      return Abc::spectral_radius(map, n_unstable, dominant);
     }
 
     template <int dim>

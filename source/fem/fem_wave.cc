@@ -9,6 +9,7 @@
 
 #include <deal.II/numerics/vector_tools.h>
 
+#include <perideal/abc/spectral_radius.h>
 #include <perideal/base/exceptions.h>
 #include <perideal/fem/fem_wave.h>
 
@@ -311,20 +312,7 @@ namespace PeriDEAL
       t            = t0;
       abc_seconds  = abc0;
       step_seconds = step0;
-      map.compute_eigenvalues(false, false);
-      double       rho  = 0.;
-      unsigned int n_up = 0;
-      for (unsigned int i = 0; i < m; ++i)
-        {
-          const double mod = std::abs(map.eigenvalue(i));
-          if (mod > rho && dominant)
-            *dominant = map.eigenvalue(i);
-          rho = std::max(rho, mod);
-          n_up += mod > 1. + 1e-8 ? 1 : 0;
-        }
-      if (n_unstable)
-        *n_unstable = n_up;
-      return rho;
+      return Abc::spectral_radius(map, n_unstable, dominant);
     }
 
     template <int dim>
