@@ -19,6 +19,8 @@
 //   --steps S        timed steps (0: enough for --seconds)
 //   --seconds T      target wall time of the timed loop (default 1)
 //   --profile-steps S  only run S Verlet steps after setup (for profilers)
+//   --trace-steps S  only run S single Verlet steps, printing each one's CPU
+//                    time and the broken-bond fraction after it
 //   --agreement FILE the LAMMPS agreement case: 12^3 nodes, m = 3, LAMMPS's
 //                    bond family (|xi| <= delta), no breaking; writes
 //                    "step i j k ux uy uz" lines every --every steps to FILE
@@ -41,6 +43,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -64,6 +67,8 @@ namespace
     unsigned int      steps         = 0;
     double            seconds       = 1.;
     unsigned int      profile_steps = 0;
+    unsigned int      trace_steps   = 0;
+    std::vector<unsigned int> chunks;
     std::string       agreement_file;
     unsigned int      agreement_steps = 200;
     unsigned int      every           = 20;
@@ -196,9 +201,76 @@ namespace
     print_exact("v0", v0);
     flush();
 
+    // With `perf record -D -1 --control fifo:CTL,ACK`, PERIDEAL_PERF_CTL=CTL
+    // and PERIDEAL_PERF_ACK=ACK, only the steps below are recorded.
+    const auto perf_control = [](const char *command) {
+      const char *ctl = std::getenv("PERIDEAL_PERF_CTL");
+      const char *ack = std::getenv("PERIDEAL_PERF_ACK");
+      if (ctl == nullptr)
+        return;
+      if (FILE *f = std::fopen(ctl, "w"))
+        {
+          std::fprintf(f, "%s\n", command);
+          std::fclose(f);
+        }
+      if (ack != nullptr)
+        if (FILE *f = std::fopen(ack, "r"))
+          {
+            char reply[8];
+            (void)!std::fgets(reply, sizeof(reply), f);
+            std::fclose(f);
+          }
+    };
     if (opt.profile_steps > 0)
       {
+        perf_control("enable");
         verlet.advance(opt.profile_steps);
+        perf_control("disable");
+        return;
+      }
+    if (!opt.chunks.empty() && model.uses_lattice_sweep())
+      {
+        // Sweep chunk sizes round robin (CPU time, median of 5 rounds),
+        // after 10 steps (the first bonds have broken).
+        verlet.advance(10);
+        typename BondBasedOperator<dim>::VectorField f;
+        model.initialize(f);
+        const unsigned int               reps = std::max(3., 0.3 * bonds > 0 ? 2e8 / bonds : 3.);
+        std::vector<std::vector<double>> cpu(opt.chunks.size());
+        for (unsigned int round = 0; round < 5; ++round)
+          for (std::size_t k = 0; k < opt.chunks.size(); ++k)
+            {
+              // c + K: chunk c, K offsets per pass (K < 8).
+              model.set_lattice_sweep_chunk(opt.chunks[k] / 8 * 8);
+              model.set_lattice_sweep_offsets_per_pass(opt.chunks[k] % 8 == 0 ? 2 : opt.chunks[k] % 8);
+              const double c0 = thread_cpu_seconds();
+              for (unsigned int r = 0; r < reps; ++r)
+                model.compute_forces(verlet.displacement, f);
+              cpu[k].push_back(thread_cpu_seconds() - c0);
+            }
+        for (std::size_t k = 0; k < opt.chunks.size(); ++k)
+          {
+            std::sort(cpu[k].begin(), cpu[k].end());
+            print("chunk_" + std::to_string(opt.chunks[k]) + "_force_bond_updates_per_cpu_second",
+                  bonds * reps / cpu[k][2]);
+          }
+        return;
+      }
+    if (opt.trace_steps > 0)
+      {
+        // Per-step CPU time of single node-ordered steps and the bonds
+        // broken so far (diagnostics: when do the bonds break?).
+        for (unsigned int s = 0; s < opt.trace_steps; ++s)
+          {
+            const double c0 = thread_cpu_seconds();
+            verlet.advance();
+            const double cpu = Utilities::MPI::sum(thread_cpu_seconds() - c0, comm);
+            if (rank == 0)
+              std::printf("%strace_step %u cpu %.4f rate %.4g broken_fraction %.5g\n",
+                          prefix.c_str(), s + 1, cpu, bonds / cpu,
+                          double(model.n_broken_bonds()) / bonds);
+            flush();
+          }
         return;
       }
 
@@ -436,6 +508,14 @@ namespace
                        [&](const std::string &arg, const std::function<std::string()> &next) {
                          if (arg == "--profile-steps")
                            opt.profile_steps = std::stoi(next());
+                         else if (arg == "--chunks")
+                           {
+                             std::istringstream in(next());
+                             for (unsigned int c; in >> c;)
+                               opt.chunks.push_back(c);
+                           }
+                         else if (arg == "--trace-steps")
+                           opt.trace_steps = std::stoi(next());
                          else if (arg == "--agreement")
                            opt.agreement_file = next();
                          else if (arg == "--agreement-steps")

@@ -7,15 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
-#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__)
-#  include <immintrin.h>
+#include <perideal/models/lattice_sweep_kernel.h>
+
+// The list loops also need AVX512BW (byte masks of the broken flags).
+#if defined(PERIDEAL_LATTICE_SWEEP_AVX512) && defined(__AVX512BW__)
 #  define PERIDEAL_PMB_AVX512 1
-// GCC 12 reports its own _mm512_undefined_pd() pass-through operands of
-// inlined AVX-512 intrinsics as maybe-uninitialized (a false positive).
-#  if defined(__GNUC__) && !defined(__clang__)
-#    pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#  endif
 #endif
 
 namespace PeriDEAL
@@ -282,6 +280,43 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  std::uint64_t
+  BondBasedOperator<dim>::find_sweep_bond(const unsigned int i,
+                                          const unsigned int h,
+                                          const bool         upper) const
+  {
+    const auto        &nb = disc.neighborhood;
+    const unsigned int S  = nb.stencil_size;
+    if (nb.table_start[i] == 0 && nb.row_start[i + 1] - nb.row_start[i] == S &&
+        sweep_slot[h] < S)
+      {
+        const std::uint64_t b = nb.row_start[i] + (upper ? S - 1 - sweep_slot[h] : sweep_slot[h]);
+        Assert(box_index(i, b) ==
+                 (upper ? 2 * centre_index() - sweep_box_index[h] : sweep_box_index[h]),
+               ExcInternalError());
+        return b;
+      }
+    return find_bond(i, upper ? 2 * centre_index() - sweep_box_index[h] : sweep_box_index[h]);
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::set_lattice_sweep_chunk(const unsigned int n)
+  {
+    check_parameter(n >= 8 && n <= max_sweep_chunk && n % 8 == 0, "Lattice sweep chunk", n,
+                    "a multiple of 8 in [8, " + std::to_string(max_sweep_chunk) + "]");
+    sweep_chunk = n;
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::set_lattice_sweep_offsets_per_pass(const unsigned int k)
+  {
+    check_parameter(k >= 1 && k <= 4, "Lattice sweep offsets per pass", k, "1, 2, 3 or 4");
+    sweep_offsets_per_pass = k;
+  }
+
+  template <int dim>
   bool
   BondBasedOperator<dim>::lattice_sweep_compiled()
   {
@@ -347,6 +382,7 @@ namespace PeriDEAL
         sweep_box_index.push_back(q);
       }
     const std::size_t n_half = sweep_offset.size();
+    sweep_slot.assign(n_half, std::numeric_limits<unsigned int>::max());
     sweep_k.assign(n_half, std::numeric_limits<double>::quiet_NaN());
     sweep_r.assign(n_half, std::numeric_limits<double>::quiet_NaN());
 
@@ -378,9 +414,23 @@ namespace PeriDEAL
               return;
           }
         if (regular)
-          table_checked.assign(1, true);
+          {
+            if (table_checked.empty())
+              for (std::uint64_t k = 0; k < n; ++k)
+                {
+                  const unsigned int q = box_index(i, begin + k);
+                  if (q > centre)
+                    sweep_slot[sweep_half_of_box[q]] = k;
+                }
+            table_checked.assign(1, true);
+          }
       }
 
+    // Offsets per pass: in 3D four (1.04-1.11x two in interleaved CPU-time
+    // runs of 3D m = 3, doc/benchmarks.md); in 2D two (four measured the
+    // same), which keeps the 2D summation order of the two-grid solver's
+    // copy of the sweep.
+    sweep_offsets_per_pass = dim == 3 ? 4 : 2;
     sweep_n_box   = n_box;
     sweep_n_bytes = (sweep_n_box + 7) / 8;
     // Padding: the neighbour streams read up to the largest offset plus one
@@ -656,140 +706,7 @@ namespace PeriDEAL
         }
     }
 
-    /**
-     * The PMB bond of eight lanes given l2 = |y|^2, the lengths rb and the
-     * stiffnesses kb: sets brk to the alive lanes with l - r > s0 r (2.34)
-     * and returns k (l - r) / l for the alive, unbroken lanes (0 for the
-     * others). 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton
-     * steps inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is
-     * the bottleneck of sqrt + div (doc/benchmarks.md); l - r by one
-     * explicit fused multiply-subtract. Every loop (full list, half list,
-     * ghost list, lattice sweep) calls this, so all of them see bitwise the
-     * same stretch of a bond and break it together. @p s0r is s0 r (the
-     * sweep passes it precomputed per offset: the same product). The
-     * unbroken lanes come from a second comparison rather than alive & ~brk,
-     * which would round-trip the mask through a general register on the
-     * critical path.
-     */
-    inline __m512d
-    pmb_bond_scale(__m512d        l2,
-                   const __mmask8 alive,
-                   const __m512d  rb,
-                   const __m512d  kb,
-                   const __m512d  s0r,
-                   __mmask8      &brk)
-    {
-      // Masked-off and broken lanes get l2 = 1 to keep inv finite.
-      l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-      const __m512d h = _mm512_mul_pd(_mm512_set1_pd(0.5), l2);
-      __m512d       inv = _mm512_rsqrt14_pd(l2);
-      for (unsigned int it = 0; it < 2; ++it)
-        inv = _mm512_mul_pd(inv,
-                            _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), _mm512_set1_pd(1.5)));
-      const __m512d  dl   = _mm512_fmsub_pd(l2, inv, rb);
-      const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_LE_OQ);
-      brk                 = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_GT_OQ);
-      return _mm512_maskz_mul_pd(keep, _mm512_mul_pd(kb, dl), inv);
-    }
-
-    /**
-     * NO positive stencil offsets hs[0], ... of the lattice sweep over the
-     * box positions [c0, c0 + n) (n and c0 multiples of 8): bond
-     * (L, L + o_q) for every live bit (hs[q], L). p and reaction are
-     * dim arrays of stride N over the box positions; the force on L is
-     * accumulated in a (the chunk's buffer, dim arrays of stride C), the
-     * reaction of node L + o in reaction (F = a - reaction). The offsets
-     * share the loads of p_L and the update of a; they must lie more than
-     * 8 apart (else the reaction update of one partially overlaps the
-     * other's, and the store cannot be forwarded). Newly broken bonds clear
-     * their bit and are appended to @p broken as (h, L).
-     */
-    template <int dim, int NO>
-    inline void
-    sweep_offsets_avx512(const double       *p,
-                         double             *reaction,
-                         double             *a,
-                         std::uint8_t       *live,
-                         const std::size_t   n_bytes,
-                         const std::size_t   N,
-                         const unsigned int  C,
-                         const std::size_t   c0,
-                         const unsigned int  n,
-                         const std::int64_t *o,
-                         const unsigned int *hs,
-                         const double       *k,
-                         const double       *r,
-                         const double        s0,
-                         std::vector<std::pair<unsigned int, std::uint32_t>> &broken)
-    {
-      // Everything loop-invariant in locals (pointers per offset and
-      // component, s0 r per offset), so that nothing is reloaded per vector.
-      std::uint8_t *bits[NO];
-      __m512d       vk[NO], vr[NO], vs0r[NO];
-      const double *pj[NO][dim];
-      double       *rj[NO][dim];
-      const double *pi_[dim];
-      double       *ai[dim];
-      for (unsigned int d = 0; d < dim; ++d)
-        {
-          pi_[d] = p + d * N + c0;
-          ai[d]  = a + d * C;
-        }
-      for (int q = 0; q < NO; ++q)
-        {
-          bits[q] = live + hs[q] * n_bytes + c0 / 8;
-          vk[q]   = _mm512_set1_pd(k[hs[q]]);
-          vr[q]   = _mm512_set1_pd(r[hs[q]]);
-          vs0r[q] = _mm512_mul_pd(_mm512_set1_pd(s0), vr[q]);
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              pj[q][d] = pi_[d] + o[hs[q]];
-              rj[q][d] = reaction + d * N + c0 + o[hs[q]];
-            }
-        }
-      for (unsigned int v = 0; v < n; v += 8)
-        {
-          __mmask8 alive[NO], any = 0;
-          for (int q = 0; q < NO; ++q)
-            any |= alive[q] = bits[q][v / 8];
-          if (any == 0)
-            continue;
-          __m512d pi[dim], acc[dim];
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              pi[d]  = _mm512_loadu_pd(pi_[d] + v);
-              acc[d] = _mm512_load_pd(ai[d] + v);
-            }
-          for (int q = 0; q < NO; ++q)
-            {
-              if (alive[q] == 0)
-                continue;
-              __m512d y[dim];
-              for (unsigned int d = 0; d < dim; ++d)
-                y[d] = _mm512_sub_pd(_mm512_loadu_pd(pj[q][d] + v), pi[d]);
-              __m512d l2 = _mm512_mul_pd(y[0], y[0]);
-              for (unsigned int d = 1; d < dim; ++d)
-                l2 = _mm512_fmadd_pd(y[d], y[d], l2);
-              __mmask8      brk;
-              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0r[q], brk);
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  double *rd = rj[q][d] + v;
-                  acc[d]     = _mm512_fmadd_pd(scale, y[d], acc[d]);
-                  _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
-                }
-              if (__builtin_expect(brk != 0, 0))
-                {
-                  bits[q][v / 8] = alive[q] & ~brk;
-                  for (unsigned int l = 0; l < 8; ++l)
-                    if ((brk >> l) & 1u)
-                      broken.emplace_back(hs[q], std::uint32_t(c0 + v + l));
-                }
-            }
-          for (unsigned int d = 0; d < dim; ++d)
-            _mm512_store_pd(ai[d] + v, acc[d]);
-        }
-    }
+    using internal::LatticeSweep::pmb_bond_scale;
 
     /**
      * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
@@ -1043,31 +960,43 @@ namespace PeriDEAL
     // chunk is done (reactions come from lower positions only). The
     // reaction array is zero between calls: each chunk clears what it
     // consumed (no separate memset pass).
-    constexpr unsigned int C = 512;
-    alignas(64) double     a[dim * C];
+    const unsigned int C = sweep_chunk;
+    alignas(64) double a[dim * max_sweep_chunk];
     const std::size_t      n_bits = 8 * sweep_n_bytes;
     double                *R      = sweep_reaction.data();
     for (std::size_t c0 = 0; c0 < n_bits; c0 += C)
       {
         const unsigned int n = std::min<std::size_t>(C, n_bits - c0);
         std::fill(a, a + dim * C, 0.);
-        // Two offsets per pass (shared p_L loads and force updates): h and
-        // h + n_pairs, which lie in different lattice lines.
-        const unsigned int n_half = sweep_offset.size(), n_pairs = n_half / 2;
-        for (unsigned int h = 0; h < n_pairs; ++h)
+        // K offsets per pass (shared p_L loads and force updates): h,
+        // h + G, h + 2G, ... (G = H / K), which lie in different lattice
+        // lines; the remainder one at a time.
+        const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
+        const auto pass = [&](auto no, const unsigned int *hs) {
+          internal::LatticeSweep::sweep_offsets<dim, decltype(no)::value>(
+            p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, nullptr, n / 8,
+            sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
+        };
+        for (unsigned int h = 0; h < G; ++h)
           {
-            const unsigned int hs[2] = {h, h + n_pairs};
-            sweep_offsets_avx512<dim, 2>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
-                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
-                                         s0, sweep_broken);
+            const unsigned int hs[4] = {h, h + G, h + 2 * G, h + 3 * G};
+            switch (K)
+              {
+                case 1:
+                  pass(std::integral_constant<int, 1>(), hs);
+                  break;
+                case 2:
+                  pass(std::integral_constant<int, 2>(), hs);
+                  break;
+                case 3:
+                  pass(std::integral_constant<int, 3>(), hs);
+                  break;
+                default:
+                  pass(std::integral_constant<int, 4>(), hs);
+              }
           }
-        if (n_half % 2)
-          {
-            const unsigned int hs[1] = {n_half - 1};
-            sweep_offsets_avx512<dim, 1>(p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, n,
-                                         sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(),
-                                         s0, sweep_broken);
-          }
+        for (unsigned int h = K * G; h < H; ++h)
+          pass(std::integral_constant<int, 1>(), &h);
         for (unsigned int d = 0; d < dim; ++d)
           {
             double *__restrict ad = a + d * C, *__restrict Rd = R + d * N + c0;
@@ -1084,14 +1013,13 @@ namespace PeriDEAL
     for (unsigned int d = 0; d < dim; ++d)
       std::fill(R + d * N + n_bits, R + (d + 1) * N, 0.);
     // Flag the CSR copies of the newly broken bonds (rare).
-    const unsigned int centre = centre_index();
     for (const auto &[h, L] : sweep_broken)
       {
         const std::int32_t lower = sweep_node[L], upper = sweep_node[L + sweep_offset[h]];
         if (lower < std::int32_t(n_owned))
-          broken_flag[find_bond(lower, sweep_box_index[h])] = 1;
+          broken_flag[find_sweep_bond(lower, h, false)] = 1;
         if (upper < std::int32_t(n_owned))
-          broken_flag[find_bond(upper, 2 * centre - sweep_box_index[h])] = 1;
+          broken_flag[find_sweep_bond(upper, h, true)] = 1;
       }
 #else
     (void)p;

@@ -6,6 +6,7 @@
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/wls_quadrature.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/models/lattice_sweep_kernel.h>
 #include <perideal/multigrid/multigrid_mechanics.h>
 
 #include <algorithm>
@@ -17,11 +18,6 @@
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #  include <immintrin.h>
 #  define PERIDEAL_MULTIGRID_AVX512 1
-// GCC 12 reports its own _mm512_undefined_pd() pass-through operands of
-// inlined AVX-512 intrinsics as maybe-uninitialized (a false positive).
-#  if defined(__GNUC__) && !defined(__clang__)
-#    pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#  endif
 #endif
 
 namespace PeriDEAL
@@ -70,96 +66,10 @@ namespace PeriDEAL
       constexpr unsigned int sweep_chunk = 512;
 
 #ifdef PERIDEAL_MULTIGRID_AVX512
-      // NO positive offsets hs[.] of the sweep over the groups of eight box
-      // positions c0 + 8 groups[.] (the chunk's groups with a live bit; c0 a
-      // multiple of 8), eight positions per iteration: bond (L, L + o) for
-      // every live bit; the force on L is accumulated in acc (stride C), its
-      // reaction on L + o in reaction (stride N). 1/|y| from vrsqrt14pd and
-      // two Newton steps (relative error ~1e-16). A bond with
-      // |y| - r > s0 r breaks (2.34): its bit is cleared, it exerts no force
-      // and is recorded in @p broken as (offset, position).
-      template <int dim, int NO>
-      inline void
-      sweep_offsets(const double                                  *p,
-                    double                                        *reaction,
-                    double                                        *acc,
-                    std::uint8_t                                  *live,
-                    const std::size_t                              n_bytes,
-                    const std::size_t                              N,
-                    const unsigned int                             C,
-                    const std::size_t                              c0,
-                    const std::uint8_t                            *groups,
-                    const unsigned int                             n_groups,
-                    const long                                    *o,
-                    const unsigned int                            *hs,
-                    const double                                  *k,
-                    const double                                  *r,
-                    const double                                   s0,
-                    std::vector<std::pair<unsigned int, long>>    &broken)
-      {
-        std::uint8_t *bits[NO];
-        __m512d       vk[NO], vr[NO];
-        for (int q = 0; q < NO; ++q)
-          {
-            bits[q] = live + hs[q] * n_bytes + c0 / 8;
-            vk[q]   = _mm512_set1_pd(k[hs[q]]);
-            vr[q]   = _mm512_set1_pd(r[hs[q]]);
-          }
-        const __m512d vs0 = _mm512_set1_pd(s0), one = _mm512_set1_pd(1.),
-                      half = _mm512_set1_pd(0.5), three_half = _mm512_set1_pd(1.5);
-        for (unsigned int gi = 0; gi < n_groups; ++gi)
-          {
-            const unsigned int v = 8 * groups[gi];
-            __mmask8           alive[NO], any = 0;
-            for (int q = 0; q < NO; ++q)
-              any |= alive[q] = bits[q][v / 8];
-            if (any == 0)
-              continue;
-            const std::size_t L = c0 + v;
-            __m512d           pi[dim], f[dim];
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                pi[d] = _mm512_loadu_pd(p + d * N + L);
-                f[d]  = _mm512_load_pd(acc + d * C + v);
-              }
-            for (int q = 0; q < NO; ++q)
-              {
-                if (alive[q] == 0)
-                  continue;
-                __m512d y[dim];
-                for (unsigned int d = 0; d < dim; ++d)
-                  y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L + o[hs[q]]), pi[d]);
-                __m512d l2 = _mm512_mul_pd(y[0], y[0]);
-                for (unsigned int d = 1; d < dim; ++d)
-                  l2 = _mm512_fmadd_pd(y[d], y[d], l2);
-                l2          = _mm512_mask_blend_pd(alive[q], one, l2);
-                const __m512d h   = _mm512_mul_pd(half, l2);
-                __m512d       inv = _mm512_rsqrt14_pd(l2);
-                for (unsigned int it = 0; it < 2; ++it)
-                  inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), three_half));
-                const __m512d  dl  = _mm512_fmsub_pd(l2, inv, vr[q]);
-                const __mmask8 brk = _mm512_mask_cmp_pd_mask(alive[q], dl,
-                                                             _mm512_mul_pd(vs0, vr[q]), _CMP_GT_OQ);
-                const __m512d  scale =
-                  _mm512_maskz_mul_pd(alive[q] & ~brk, _mm512_mul_pd(vk[q], dl), inv);
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    double *rd = reaction + d * N + L + o[hs[q]];
-                    f[d]       = _mm512_fmadd_pd(scale, y[d], f[d]);
-                    _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
-                  }
-                if (brk)
-                  {
-                    bits[q][v / 8] = alive[q] & ~brk;
-                    for (unsigned int l = 0; l < 8; ++l)
-                      if ((brk >> l) & 1u)
-                        broken.emplace_back(hs[q], long(L + l));
-                  }
-              }
-            for (unsigned int d = 0; d < dim; ++d)
-              _mm512_store_pd(acc + d * C + v, f[d]);
-          }
-      }
+      // The lattice-sweep kernel of BondBasedOperator (bitwise the same
+      // stretch and breaking decisions): NO offsets over the listed groups
+      // of eight box positions of a chunk.
+      using internal::LatticeSweep::sweep_offsets;
 #endif
 
       // The portable counterpart of sweep_offsets() for one offset h.

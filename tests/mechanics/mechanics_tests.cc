@@ -4,12 +4,15 @@
 
 #include <perideal/base/exceptions.h>
 #include <perideal/discretization/discretization.h>
+#include <perideal/discretization/domain.h>
 #include <perideal/models/bond_based.h>
+#include <perideal/time_stepping/mechanics_solver.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
 #include "../check.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 using namespace dealii;
@@ -811,11 +814,106 @@ namespace
     check(a.kinetic_energy() == b.kinetic_energy(), tag + "kinetic energy " + sci(b.kinetic_energy()));
   }
 
+  // MechanicsSolver::run() steps in advance(n) batches between the steps
+  // that write a CSV row or a checkpoint: it must give bitwise the same time
+  // series, state and broken bonds as stepping one step per call (run(1),
+  // which runs the node-ordered advance()), with a pre-crack, breaking
+  // bonds, a prescribed velocity, a prescribed displacement (reaction forces
+  // in the CSV) and a body force; output intervals that do not divide each
+  // other; on 1 and 2 ranks.
+  template <int dim>
+  void
+  solver_batches_dim()
+  {
+    const MPI_Comm    comm = MPI_COMM_WORLD;
+    const double      side = dim == 3 ? 1. : 2.;
+    const std::string tag  = std::to_string(dim) + "D, " +
+                            std::to_string(Utilities::MPI::n_mpi_processes(comm)) + " ranks: ";
+    const auto make = [&](const std::string &directory) {
+      MechanicsRunParameters<dim> p;
+      Point<dim>                  upper;
+      for (unsigned int d = 0; d < dim; ++d)
+        upper[d] = side;
+      p.domain                 = std::make_shared<BoxDomain<dim>>(Point<dim>(), upper);
+      p.lattice.dx             = 0.1;
+      p.lattice.delta          = 0.3015;
+      p.lattice.layer_thickness = 0.;
+      p.model.critical_stretch = 0.01;
+      const std::string zeros  = dim == 3 ? "0; 0" : "0";
+      p.prescribed_velocities.push_back(
+        {std::to_string(side - 0.25) + " - y", zeros + "; 0.02 + 0.01 * x + 0.05 * t", 0.});
+      p.prescribed_displacements.push_back(
+        {"y - 0.15", (dim == 3 ? "0.001 * t * x; 0; -0.002 * t * t" : "0.001 * t * x; -0.002 * t * t"), 0.});
+      p.body_force       = dim == 3 ? "0; 0; 0.01 * sin(x)" : "0; 0.01 * sin(x)";
+      p.initial_velocity = dim == 3 ? "1e-3 * y; 0; 2e-3 * x" : "1e-3 * y; 2e-3 * x";
+      std::vector<Point<dim>> crack(dim == 3 ? 4 : 2);
+      if constexpr (dim == 2)
+        crack = {Point<dim>(-0.1, 0.55 * side), Point<dim>(0.75, 0.55 * side)};
+      else
+        crack = {Point<dim>(-0.1, 0.55, -0.1), Point<dim>(0.5, 0.55, -0.1),
+                 Point<dim>(0.5, 0.55, 1.1), Point<dim>(-0.1, 0.55, 1.1)};
+      p.precracks.push_back(crack);
+      p.end_time             = 40.;
+      p.time_series_interval = 6;
+      p.checkpoint_interval  = 11;
+      p.snapshot_interval    = 0;
+      p.output_directory     = directory;
+      p.progress_interval    = 1e9;
+      return p;
+    };
+    const std::string prefix = "solver_batches_" + std::to_string(dim) + "d_np" +
+                               std::to_string(Utilities::MPI::n_mpi_processes(comm));
+    MechanicsSolver<dim> single(comm, make(prefix + "_single")), batched(comm, make(prefix + "_batched"));
+    single.setup();
+    batched.setup();
+    // The step from 0.9 x the critical one: a few tens of steps.
+    const double dt = single.integrator().time_step();
+    check(dt > 0. && 40. / dt > 20. && 40. / dt < 400., tag + "dt = " + sci(dt));
+    const std::uint64_t pre = single.model().n_broken_bonds();
+    unsigned int before;
+    do
+      {
+        before = single.integrator().step();
+        single.run(1);
+      }
+    while (single.integrator().step() != before);
+    batched.run();
+    if (BondBasedOperator<dim>::lattice_sweep_compiled())
+      check(batched.integrator().uses_box_state(), tag + "run() can keep the state in the box layout");
+    const auto &a = single.integrator(), &b = batched.integrator();
+    const auto &disc   = single.discretization();
+    unsigned int differ = a.step() != b.step() || a.time() != b.time();
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          differ += a.displacement[d].local_element(i) != b.displacement[d].local_element(i) ||
+                    a.velocity[d].local_element(i) != b.velocity[d].local_element(i) ||
+                    a.acceleration[d].local_element(i) != b.acceleration[d].local_element(i);
+      }
+    for (std::size_t k = 0; k < single.model().broken().size(); ++k)
+      differ += single.model().broken()[k] != batched.model().broken()[k];
+    const auto &ra = single.time_series(), &rb = batched.time_series();
+    differ += ra.size() != rb.size();
+    for (std::size_t r = 0; r < std::min(ra.size(), rb.size()); ++r)
+      for (std::size_t c = 0; c + 1 < ra[r].size(); ++c) // the last column is the wall time
+        differ += !(ra[r][c] == rb[r][c]) && !(std::isnan(ra[r][c]) && std::isnan(rb[r][c]));
+    differ = Utilities::MPI::sum(differ, comm);
+    check(differ == 0, tag + std::to_string(differ) +
+                         " values (u, v, a, broken flags, CSV entries, step) differ from run(1) steps");
+    const std::uint64_t broken = batched.model().n_broken_bonds();
+    check(pre > 0 && broken > pre, tag + std::to_string(pre) + " pre-cut, " +
+                                     std::to_string(broken - pre) + " newly broken bond copies in " +
+                                     std::to_string(b.step()) + " steps, " +
+                                     std::to_string(rb.size()) + " CSV rows");
+  }
+
   void
   box_state()
   {
     box_state_dim<2>();
     box_state_dim<3>();
+    solver_batches_dim<2>();
+    solver_batches_dim<3>();
   }
 } // namespace
 

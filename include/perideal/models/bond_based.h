@@ -229,6 +229,21 @@ namespace PeriDEAL
       return sweep_available;
     }
 
+    /**
+     * Box positions per chunk of the lattice sweep (a multiple of 8, at most
+     * max_sweep_chunk): a tuning knob, results do not depend on it.
+     */
+    void
+    set_lattice_sweep_chunk(const unsigned int n);
+    /**
+     * Stencil offsets evaluated per pass over a chunk (1-4, sharing the
+     * loads of p_L and the force accumulator): a tuning knob; the forces
+     * change by round-off (summation order), the broken bonds do not.
+     */
+    void
+    set_lattice_sweep_offsets_per_pass(const unsigned int k);
+    /** Largest chunk of set_lattice_sweep_chunk(). */
+    static constexpr unsigned int max_sweep_chunk = 2048;
     /** True if the library was compiled with the AVX-512 sweep kernel. */
     static bool
     lattice_sweep_compiled();
@@ -406,6 +421,10 @@ namespace PeriDEAL
     /** CSR index of the copy of bond @p b (row @p i, owned neighbour) in the neighbour's row. */
     std::uint64_t
     mirror_bond(const unsigned int i, const std::uint64_t b) const;
+    /** Box positions per chunk of the sweep (set_lattice_sweep_chunk()). */
+    unsigned int sweep_chunk = 512;
+    /** Offsets per pass of the sweep (set_lattice_sweep_offsets_per_pass()). */
+    unsigned int sweep_offsets_per_pass = 2;
     /** Lattice sweep selected (set_lattice_sweep()) and possible. */
     bool sweep = true, sweep_available = false;
     /** The sweep's live bits are in sync with broken_flag. */
@@ -418,6 +437,12 @@ namespace PeriDEAL
     /** Per positive stencil offset h: linear box offset, box index, stiffness, length. */
     std::vector<std::int64_t> sweep_offset;
     std::vector<unsigned int> sweep_box_index;
+    /**
+     * Per positive offset h: its slot in a regular row (one that lists the
+     * whole stencil in order; the negated offset has slot S-1-slot), so that
+     * a broken bond finds its CSR copies without a binary search.
+     */
+    std::vector<unsigned int> sweep_slot;
     std::vector<double>       sweep_k, sweep_r;
     /** Stencil-box index -> positive offset h (or of its negation), -1 for the centre. */
     std::vector<int> sweep_half_of_box;
@@ -442,6 +467,12 @@ namespace PeriDEAL
     /** CSR index of the bond of owned row @p i with stencil-box index @p target. */
     std::uint64_t
     find_bond(const unsigned int i, const unsigned int target) const;
+    /**
+     * find_bond() for the lower (@p upper false) or upper end @p i of a bond
+     * of positive sweep offset @p h: direct in a regular row.
+     */
+    std::uint64_t
+    find_sweep_bond(const unsigned int i, const unsigned int h, const bool upper) const;
     /** Build half_offset and the ghost list. */
     void
     setup_half_list();
