@@ -121,6 +121,7 @@ namespace PeriDEAL
           }
         const auto group = [&](const unsigned int v) {
           __mmask8 alive[NO], any = 0;
+#  pragma GCC unroll 4
           for (int q = 0; q < NO; ++q)
             any |= alive[q] = bits[q][v / 8];
           if (any == 0)
@@ -131,6 +132,9 @@ namespace PeriDEAL
               pi[d] = _mm512_loadu_pd(pi_[d] + v);
               f[d]  = _mm512_load_pd(ai[d] + v);
             }
+          // Unrolled: the per-offset constants and pointers stay in
+          // registers (a rolled loop reloads them from the stack per vector).
+#  pragma GCC unroll 4
           for (int q = 0; q < NO; ++q)
             {
               if (alive[q] == 0)
