@@ -361,7 +361,8 @@ namespace
   // free nodes (the force of the exact field against the continuum's).
   double
   lps_m_error(const double delta, const unsigned int m, const std::string &q,
-              const unsigned int order, double &consistency, double &residual)
+              const unsigned int order, double &consistency, double &residual,
+              const std::string &linear_solver = "direct")
   {
     const auto waves = lps_plane_waves(delta);
     auto       exact = [waves](const Point<2> &x) {
@@ -371,6 +372,8 @@ namespace
       return u;
     };
     auto p       = lps_parameters(delta, m, q, order);
+    p.solver     = linear_solver;
+    p.tolerance  = 1e-11;
     p.body_force = [waves](const Point<2> &x) {
       Tensor<1, 2> b;
       for (const auto &w : waves)
@@ -441,6 +444,18 @@ namespace
       check(res < 1e-10, name + ", m = " + std::to_string(m) + ": linear system solved, residual " +
                            sci(res));
     };
+    {
+      // the iterative path: GMRES, right-preconditioned with the AMG of the
+      // standard stiffness, stopping on the true residual
+      double t, res;
+      const double e = lps_m_error(delta, 4, "wls", 2, t, res, "cg-amg");
+      const double e_direct = lps_m_error(delta, 4, "wls", 2, t, t);
+      if (root())
+        std::cout << "    WLS-2, m = 4, GMRES + AMG: error " << sci(e) << ", residual "
+                  << sci(res) << " (direct: error " << sci(e_direct) << ")" << std::endl;
+      check(res < 1e-10 && std::abs(e - e_direct) < 1e-6 * e_direct,
+            "WLS-2, m = 4: GMRES + AMG reaches the direct solution");
+    }
     for (const unsigned int m : ms)
       {
         run_case("standard", m, "standard", 2);
