@@ -30,4 +30,4 @@ foreach(_t lps_polynomial wave_energy be_diffusion)
     COMMAND $<TARGET_FILE:wls_ext_tests> ${_t} LABELS "unit;mpi")
 endforeach()
 perideal_add_test(NAME wls.ext.lps_m_convergence COMMAND $<TARGET_FILE:wls_ext_tests>
-  lps_m_convergence LABELS "convergence;long" TIMEOUT 900)
+  lps_m_convergence LABELS "convergence;long" TIMEOUT 1800)
