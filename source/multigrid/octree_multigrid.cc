@@ -4,6 +4,12 @@
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_tools.h>
 
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+#include <deal.II/lac/trilinos_vector.h>
+
 #include <perideal/base/exceptions.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/multigrid/lattice_tools.h>
@@ -27,8 +33,9 @@ namespace PeriDEAL
       check_parameter(grid.interpolation != Interpolation::nearest_active,
                       "Multi-grid/Interpolation", "nearest active",
                       "'inverse distance' or 'multilinear' on the octree");
-      check_parameter(transport.scheme == "forward Euler", "Time stepping/Scheme",
-                      transport.scheme, "'forward Euler' on the octree multi-grid");
+      check_parameter(transport.scheme == "forward Euler" || transport.scheme == "backward Euler",
+                      "Time stepping/Scheme", transport.scheme,
+                      "'forward Euler' or 'backward Euler' on the octree multi-grid");
       check_parameter(transport.coarse_quadrature == "standard",
                       "Multi-grid/Coarse quadrature", transport.coarse_quadrature,
                       "'standard' on the octree multi-grid");
@@ -44,7 +51,21 @@ namespace PeriDEAL
                       indicator_threshold, "a positive number");
       check_parameter(switching_interval >= 1, "Multi-grid/Switching interval",
                       switching_interval, "an integer >= 1");
+      if (coarsening)
+        check_parameter(coarsening_threshold > 0. && coarsening_threshold < indicator_threshold,
+                        "Multi-grid/Coarsening threshold", coarsening_threshold,
+                        "a positive number below the indicator threshold " +
+                          std::to_string(indicator_threshold));
     }
+
+    template <int dim>
+    struct OctreeMultiGrid<dim>::Implicit
+    {
+      TrilinosWrappers::SparseMatrix                  matrix;
+      SolverControl                                   control{1, 0.};
+      std::unique_ptr<TrilinosWrappers::SolverDirect> solver;
+      bool                                            valid = false;
+    };
 
     namespace
     {
@@ -91,6 +112,7 @@ namespace PeriDEAL
       : comm(comm_)
       , prm(p)
       , tria(comm_)
+      , implicit(std::make_unique<Implicit>())
     {
       static_assert(dim >= 2, "p4est: 2D and 3D only");
       prm.check();
@@ -459,30 +481,22 @@ namespace PeriDEAL
     }
 
     template <int dim>
+    template <typename F>
     void
-    OctreeMultiGrid<dim>::compute_time_step_bound()
+    OctreeMultiGrid<dim>::operator_entries(const bool kappa_max, const F &emit) const
     {
-      // Gershgorin of the fictitious-expanded operator with the largest
-      // kappa: interpolation coupling 1/|L_ii| (rows sum to 0, off-diagonal
-      // entries >= 0: max principle, as the serial solver); conservative
-      // coupling 2/(|L_ii| + R_i) with the pay-back entries of remote rows
-      // gathered by compress(add), duplicates not merged (R_i is then an
-      // upper bound of the serial solver's: the bound is never larger).
+      // (3.82)/(3.84) row by row as apply(): (i, j) += c, (i, i) -= c, and
+      // the conservative pay-back of fine rows to the donors of C_j
       const auto  &tp   = prm.transport;
       const double kmax = tp.corrosion ? std::max({tp.kappa_liquid, tp.kappa_interface,
                                                    tp.kappa_solid}) :
                                          tp.kappa;
-      LinearAlgebra::distributed::Vector<double> diag(C), off(C);
-      for (unsigned int i = 0; i < n_local_active; ++i)
-        diag.local_element(i) = off.local_element(i) = 0.;
-      auto add = [&](const unsigned int row, const unsigned int c, const double v) {
+      auto expand = [&](const unsigned int row, const unsigned int c, const double v) {
         if (c < n_local_active)
-          (c == row ? diag.local_element(row) : off.local_element(row)) +=
-            c == row ? v : std::abs(v);
+          emit(row, c, v);
         else
           for (const auto &[a, wa] : active_interpolation[c - n_local_active])
-            (a == row ? diag.local_element(row) : off.local_element(row)) +=
-              a == row ? v * wa : std::abs(v * wa);
+            emit(row, a, v * wa);
       };
       for (unsigned int i = 0; i < n_owned; ++i)
         {
@@ -494,18 +508,41 @@ namespace PeriDEAL
               const bool         fict = j >= n_local_active;
               if (fict && tp.conservative && !fine)
                 continue;
-              const double c = kmax * stencil_weight[fine][bond_entry[b]];
-              add(i, j, c);
-              diag.local_element(i) -= c;
+              const double c = (kappa_max ? kmax : bond_kappa(work_phase[i], work_phase[j])) *
+                               stencil_weight[fine][bond_entry[b]];
+              expand(i, j, c);
+              emit(i, i, -c);
               if (fict && tp.conservative)
                 for (const auto &[a, wa] : active_interpolation[j - n_local_active])
                   {
                     const double f = wa * c * Vi / std::pow(node_fine[a] ? h : H, dim);
-                    add(a, j, -f);
-                    add(a, i, f);
+                    expand(a, j, -f);
+                    emit(a, i, f);
                   }
             }
         }
+    }
+
+    template <int dim>
+    void
+    OctreeMultiGrid<dim>::compute_time_step_bound()
+    {
+      // Gershgorin of the fictitious-expanded operator with the largest
+      // kappa: interpolation coupling 1/|L_ii| (rows sum to 0, off-diagonal
+      // entries >= 0: max principle, as the serial solver); conservative
+      // coupling 2/(|L_ii| + R_i) with the pay-back entries of remote rows
+      // gathered by compress(add), duplicates not merged (R_i is then an
+      // upper bound of the serial solver's: the bound is never larger).
+      const auto &tp = prm.transport;
+      LinearAlgebra::distributed::Vector<double> diag(C), off(C);
+      for (unsigned int i = 0; i < n_local_active; ++i)
+        diag.local_element(i) = off.local_element(i) = 0.;
+      operator_entries(true, [&](const unsigned int row, const unsigned int c, const double v) {
+        if (c == row)
+          diag.local_element(row) += v;
+        else
+          off.local_element(row) += std::abs(v);
+      });
       diag.compress(VectorOperation::add);
       off.compress(VectorOperation::add);
       double bound = std::numeric_limits<double>::infinity();
@@ -517,9 +554,11 @@ namespace PeriDEAL
         }
       dt_critical = Utilities::MPI::min(bound, comm);
       dt          = tp.time_step > 0. ? tp.time_step : 0.9 * dt_critical;
-      check_parameter(dt <= dt_critical * (1. + 1e-12), "Time stepping/Time step", dt,
-                      "a step not above the forward Euler bound " + std::to_string(dt_critical) +
-                        " of the current multi-grid");
+      if (tp.scheme == "forward Euler")
+        check_parameter(dt <= dt_critical * (1. + 1e-12), "Time stepping/Time step", dt,
+                        "a step not above the forward Euler bound " +
+                          std::to_string(dt_critical) + " of the current multi-grid");
+      implicit->valid = false;
     }
 
     template <int dim>
@@ -611,32 +650,13 @@ namespace PeriDEAL
     }
 
     template <int dim>
-    void
-    OctreeMultiGrid<dim>::advance()
-    {
-      apply(rate);
-      for (unsigned int i = 0; i < n_owned; ++i)
-        C.local_element(i) += dt * rate.local_element(i);
-      if (prm.transport.corrosion)
-        for (unsigned int i = 0; i < n_owned; ++i)
-          if (phase.local_element(i) > 0.5 && C.local_element(i) < prm.transport.saturation)
-            phase.local_element(i) = 0.; // (2.79), one way
-      C.update_ghost_values();
-      phase.update_ghost_values();
-      refresh_work();
-      t += dt;
-      ++n_step;
-      if (prm.switching && n_step % prm.switching_interval == 0)
-        adapt();
-    }
-
-    template <int dim>
     unsigned int
     OctreeMultiGrid<dim>::adapt()
     {
-      // 1. indicator on owned coarse cells: range of C over the cell's
-      // active nodes
-      std::map<long long, std::pair<double, double>> block_range; // local blocks
+      // 1. indicator on the owned cells: range of C over the cell's active
+      // nodes, and whether they hold both phases (every rank gets all cells)
+      std::vector<double> range(block_fine.size(), 0.);
+      std::vector<int>    mixed(block_fine.size(), 0);
       {
         std::vector<Index> nodes;
         for (const auto &cell : tria.active_cell_iterators())
@@ -645,21 +665,27 @@ namespace PeriDEAL
               const long long b = block_of_cell(cell);
               block_nodes(b, block_fine[b], nodes);
               double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+              bool   solid = false, liquid = false;
               for (const auto &i : nodes)
                 {
-                  const double c = C.local_element(local_of_id.at(id_of(block_fine[b], i)));
-                  lo             = std::min(lo, c);
-                  hi             = std::max(hi, c);
+                  const unsigned int a = local_of_id.at(id_of(block_fine[b], i));
+                  lo                   = std::min(lo, C.local_element(a));
+                  hi                   = std::max(hi, C.local_element(a));
+                  (phase.local_element(a) > 0.5 ? solid : liquid) = true;
                 }
-              block_range[b] = {lo, hi};
+              range[b] = nodes.empty() ? 0. : hi - lo;
+              mixed[b] = solid && liquid;
             }
       }
+      MPI_Allreduce(MPI_IN_PLACE, range.data(), range.size(), MPI_DOUBLE, MPI_MAX, comm);
+      MPI_Allreduce(MPI_IN_PLACE, mixed.data(), mixed.size(), MPI_INT, MPI_MAX, comm);
       auto neighbours = [&](const long long b) {
+        // b itself and its 3^dim - 1 neighbours
         std::vector<long long> out;
         const Index            B = unravel<dim>(b, n_blocks);
         for (unsigned int q = 0; q < std::pow(3, dim); ++q)
           {
-            Index     N;
+            Index        N;
             unsigned int rest = q;
             for (unsigned int d = 0; d < dim; ++d)
               {
@@ -671,34 +697,64 @@ namespace PeriDEAL
           }
         return out;
       };
-      std::vector<int> critical(block_fine.size(), 0);
-      for (const auto &cell : tria.active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            const long long b = block_of_cell(cell);
-            const auto     &r = block_range.at(b);
-            critical[b]       = !block_fine[b] && r.second - r.first > prm.indicator_threshold;
-          }
-      MPI_Allreduce(MPI_IN_PLACE, critical.data(), critical.size(), MPI_INT, MPI_MAX, comm);
       std::vector<char> new_fine = block_fine;
-      unsigned int      n_switched = 0;
       for (long long b = 0; b < (long long)block_fine.size(); ++b)
         if (!block_fine[b])
-          for (const long long n : neighbours(b))
-            if (critical[n])
-              {
+          {
+            // a critical coarse cell and its neighbours become fine
+            for (const long long n : neighbours(b))
+              if (!block_fine[n] && range[n] > prm.indicator_threshold)
                 new_fine[b] = 1;
-                ++n_switched;
-                break;
-              }
+          }
+        else if (prm.coarsening)
+          {
+            // the front has passed: smooth and single-phase all around
+            // (coarsening_threshold < indicator_threshold: no flip-flop)
+            bool smooth = true;
+            for (const long long n : neighbours(b))
+              smooth = smooth && range[n] < prm.coarsening_threshold && !mixed[n];
+            if (smooth)
+              new_fine[b] = 0;
+          }
+      return transfer(new_fine);
+    }
+
+    template <int dim>
+    unsigned int
+    OctreeMultiGrid<dim>::set_fine_cells(const std::function<bool(const Point<dim> &)> &fine)
+    {
+      std::vector<char> new_fine(block_fine.size());
+      for (long long b = 0; b < (long long)block_fine.size(); ++b)
+        {
+          const Index B = unravel<dim>(b, n_blocks);
+          Point<dim>  centre;
+          for (unsigned int d = 0; d < dim; ++d)
+            centre[d] = prm.grid.lower[d] - 0.5 * H + (B[d] + 0.5) * k_cell * H;
+          new_fine[b] = fine(centre) ? 1 : 0;
+        }
+      return transfer(new_fine);
+    }
+
+    template <int dim>
+    unsigned int
+    OctreeMultiGrid<dim>::transfer(const std::vector<char> &new_fine)
+    {
+      unsigned int n_switched = 0, n_to_coarse = 0;
+      for (std::size_t b = 0; b < block_fine.size(); ++b)
+        if (new_fine[b] != block_fine[b])
+          {
+            ++n_switched;
+            n_to_coarse += block_fine[b];
+          }
       if (n_switched == 0)
         return 0;
 
-      // 2. values of the owned cells under the new flags: a switched cell
-      // takes the fine fictitious interpolation from the coarse grid
+      // 2. values of the owned cells under the new flags: a cell switched
+      // to fine takes the fine fictitious interpolation from the coarse
+      // grid, a cell switched to coarse the cell means of the fine values
       std::map<long long, std::vector<double>> outgoing;
       {
-        std::vector<Index>  nodes, corners, fine_corners;
+        std::vector<Index>  nodes, corners, fine_corners, old_nodes;
         std::vector<double> w, wf;
         // value of a coarse lattice point: active, or fictitious (from the
         // fine nodes of its refined cell); C and phase
@@ -727,36 +783,55 @@ namespace PeriDEAL
               block_nodes(b, new_fine[b], nodes);
               auto &v = outgoing[b];
               v.assign(2 * nodes.size(), 0.);
-              for (unsigned int q = 0; q < nodes.size(); ++q)
-                if (new_fine[b] == block_fine[b])
+              if (new_fine[b] == block_fine[b])
+                for (unsigned int q = 0; q < nodes.size(); ++q)
                   {
                     const unsigned int a = local_of_id.at(id_of(block_fine[b], nodes[q]));
                     v[q]                 = C.local_element(a);
                     v[nodes.size() + q]  = phase.local_element(a);
                   }
-                else
-                  {
-                    corner_interpolation<dim>(point_of(true, nodes[q]), prm.grid.lower, H, nc,
-                                              prm.grid.interpolation, corners, w);
-                    double ph = 0.;
-                    for (unsigned int c = 0; c < corners.size(); ++c)
-                      if (w[c] > 0.)
-                        {
-                          const auto cv = coarse_value(corners[c]);
-                          v[q] += w[c] * cv[0];
-                          ph += w[c] * cv[1];
-                        }
-                    v[nodes.size() + q] = ph >= 0.5 ? 1. : 0.;
-                  }
-              if (new_fine[b] != block_fine[b] && !nodes.empty())
+              else if (!new_fine[b])
                 {
+                  // fine -> coarse: the mean of the r^dim fine nodes of each
+                  // coarse cell (block_nodes() lists them consecutively)
+                  block_nodes(b, true, old_nodes);
+                  const std::size_t r_dim = nodes.empty() ? 0 : old_nodes.size() / nodes.size();
+                  for (std::size_t K = 0; K < nodes.size(); ++K)
+                    {
+                      double c = 0., ph = 0.;
+                      for (std::size_t q = K * r_dim; q < (K + 1) * r_dim; ++q)
+                        {
+                          const unsigned int a = local_of_id.at(id_of(true, old_nodes[q]));
+                          c += C.local_element(a);
+                          ph += phase.local_element(a);
+                        }
+                      v[K]                = c / r_dim;
+                      v[nodes.size() + K] = ph / r_dim >= 0.5 ? 1. : 0.;
+                    }
+                }
+              else
+                {
+                  for (unsigned int q = 0; q < nodes.size(); ++q)
+                    {
+                      corner_interpolation<dim>(point_of(true, nodes[q]), prm.grid.lower, H, nc,
+                                                prm.grid.interpolation, corners, w);
+                      double ph = 0.;
+                      for (unsigned int c = 0; c < corners.size(); ++c)
+                        if (w[c] > 0.)
+                          {
+                            const auto cv = coarse_value(corners[c]);
+                            v[q] += w[c] * cv[0];
+                            ph += w[c] * cv[1];
+                          }
+                      v[nodes.size() + q] = ph >= 0.5 ? 1. : 0.;
+                    }
                   // mass bookkeeping: shift the r^dim fine values of each
                   // coarse cell so that their mean is the coarse value
                   // (exact for linear C already; the shift removes the
                   // curvature error, so switching conserves mass)
                   std::vector<Index> coarse;
                   block_nodes(b, false, coarse);
-                  const std::size_t r_dim = nodes.size() / coarse.size();
+                  const std::size_t r_dim = coarse.empty() ? 0 : nodes.size() / coarse.size();
                   for (std::size_t K = 0; K < coarse.size(); ++K)
                     {
                       const double c_K = C.local_element(local_of_id.at(id_of(false, coarse[K])));
@@ -798,7 +873,84 @@ namespace PeriDEAL
       build(&incoming);
       incoming.clear();
       ++n_switch_events;
+      n_coarsened_cells += n_to_coarse;
       return n_switched;
+    }
+
+    template <int dim>
+    void
+    OctreeMultiGrid<dim>::implicit_step()
+    {
+      // (M/dt - L) C^{n+1} = C^n/dt, fictitious values eliminated; rows of
+      // the owned nodes, the pay-back into ghost rows sent by compress()
+      const auto &part = *C.get_partitioner();
+      if (!implicit->valid)
+        {
+          IndexSet writable(part.size());
+          writable.add_range(part.local_range().first, part.local_range().second);
+          writable.add_indices(part.ghost_indices());
+          writable.compress();
+          TrilinosWrappers::SparsityPattern sp(part.locally_owned_range(),
+                                               part.locally_owned_range(), writable, comm);
+          auto g = [&](const unsigned int i) { return part.local_to_global(i); };
+          for (unsigned int i = 0; i < n_owned; ++i)
+            sp.add(g(i), g(i));
+          operator_entries(false, [&](const unsigned int r, const unsigned int c, const double) {
+            sp.add(g(r), g(c));
+          });
+          sp.compress();
+          implicit->matrix.reinit(sp);
+          for (unsigned int i = 0; i < n_owned; ++i)
+            implicit->matrix.add(g(i), g(i), 1. / dt);
+          operator_entries(false, [&](const unsigned int r, const unsigned int c, const double v) {
+            implicit->matrix.add(g(r), g(c), -v);
+          });
+          implicit->matrix.compress(VectorOperation::add);
+          implicit->solver = std::make_unique<TrilinosWrappers::SolverDirect>(implicit->control);
+          implicit->solver->initialize(implicit->matrix);
+          implicit->valid = true;
+        }
+      TrilinosWrappers::MPI::Vector rhs(part.locally_owned_range(), comm), x(rhs);
+      for (unsigned int i = 0; i < n_owned; ++i)
+        rhs[part.local_to_global(i)] = C.local_element(i) / dt;
+      rhs.compress(VectorOperation::insert);
+      implicit->solver->solve(x, rhs);
+      for (unsigned int i = 0; i < n_owned; ++i)
+        C.local_element(i) = x[part.local_to_global(i)];
+    }
+
+    template <int dim>
+    void
+    OctreeMultiGrid<dim>::advance()
+    {
+      if (prm.transport.scheme == "backward Euler")
+        implicit_step();
+      else
+        {
+          apply(rate);
+          for (unsigned int i = 0; i < n_owned; ++i)
+            C.local_element(i) += dt * rate.local_element(i);
+        }
+      if (prm.transport.corrosion)
+        {
+          int changed = 0;
+          for (unsigned int i = 0; i < n_owned; ++i)
+            if (phase.local_element(i) > 0.5 && C.local_element(i) < prm.transport.saturation)
+              {
+                phase.local_element(i) = 0.; // (2.79), one way
+                changed                = 1;
+              }
+          // the implicit system depends on the phase (kappa of the bonds)
+          if (prm.transport.scheme == "backward Euler" && Utilities::MPI::max(changed, comm))
+            implicit->valid = false;
+        }
+      C.update_ghost_values();
+      phase.update_ghost_values();
+      refresh_work();
+      t += dt;
+      ++n_step;
+      if (prm.switching && n_step % prm.switching_interval == 0)
+        adapt();
     }
 
     template <int dim>

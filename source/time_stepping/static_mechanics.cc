@@ -5,6 +5,7 @@
 #include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
 
 #include <perideal/base/exceptions.h>
 #include <perideal/base/expressions.h>
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 namespace PeriDEAL
 {
@@ -268,6 +270,138 @@ namespace PeriDEAL
 
   template <int dim>
   void
+  StaticMechanicsSolver<dim>::assemble_by_probing(TrilinosWrappers::SparseMatrix &matrix)
+  {
+    // The WLS force is linear in u but has no bond structure to assemble
+    // from, so its matrix is recovered column by column from compute_forces():
+    // the force of row i depends on u within the two-hop reach R = 2 (delta
+    // + dx/2) (the fit of i reads its collocation nodes' dilatations, each a
+    // fit over that node's family). Nodes whose lattice coordinates agree
+    // modulo P = 2 R/dx + 1 (rounded up) are at least 2 R + dx apart, so the
+    // rows reached by two probed nodes of one colour never overlap: one
+    // evaluation per colour and component gives all those columns. Rows and
+    // columns of prescribed nodes are removed, their diagonal is 1 (as
+    // Stiffness::assemble).
+    const double    dx    = prm.lattice.dx;
+    const long long reach = (long long)std::ceil(2. * (prm.lattice.delta + 0.5 * dx) / dx - 1e-9);
+    const long long P     = 2 * reach + 1;
+    const unsigned int n_local = disc.n_owned() + disc.n_ghost();
+    // integer lattice coordinates relative to the global lowest node
+    Point<dim> lo;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        double l = std::numeric_limits<double>::max();
+        for (unsigned int i = 0; i < n_local; ++i)
+          l = std::min(l, disc.position[i][d]);
+        lo[d] = Utilities::MPI::min(l, mpi_communicator);
+      }
+    std::vector<std::array<long long, dim>> coord(n_local);
+    for (unsigned int i = 0; i < n_local; ++i)
+      for (unsigned int d = 0; d < dim; ++d)
+        coord[i][d] = std::llround((disc.position[i][d] - lo[d]) / dx);
+    auto key = [](const std::array<long long, dim> &c) {
+      long long k = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        k = k * (1LL << 20) + c[d];
+      return k;
+    };
+    // lattice key -> global node index of every node (the two-hop reach
+    // exceeds the ghost layer); small static problems only
+    std::vector<long long> mine;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      mine.insert(mine.end(),
+                  {key(coord[i]), (long long)disc.partitioner()->local_to_global(i)});
+    std::map<long long, types::global_dof_index> global_of;
+    for (const auto &v : Utilities::MPI::all_gather(mpi_communicator, mine))
+      for (std::size_t q = 0; q < v.size(); q += 2)
+        global_of[v[q]] = v[q + 1];
+    std::vector<char> fixed_global(disc.n_global(), 0);
+    {
+      std::vector<types::global_dof_index> f;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (fixed[i])
+          f.push_back(disc.partitioner()->local_to_global(i));
+      for (const auto &v : Utilities::MPI::all_gather(mpi_communicator, f))
+        for (const auto g : v)
+          fixed_global[g] = 1;
+    }
+
+    VectorField probe, force;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        disc.initialize_vector(probe[d]);
+        disc.initialize_vector(force[d]);
+      }
+    const types::global_dof_index              first = disc.partitioner()->local_range().first;
+    std::vector<std::map<types::global_dof_index, double>> rows(dim * disc.n_owned());
+    long long n_colours = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      n_colours *= P;
+    for (long long colour = 0; colour < n_colours; ++colour)
+      {
+        std::array<long long, dim> cc;
+        for (long long rest = colour, d = 0; d < dim; ++d, rest /= P)
+          cc[d] = rest % P;
+        auto has_colour = [&](const std::array<long long, dim> &c) {
+          for (unsigned int d = 0; d < dim; ++d)
+            if (c[d] % P != cc[d])
+              return false;
+          return true;
+        };
+        for (unsigned int comp = 0; comp < dim; ++comp)
+          {
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int i = 0; i < n_local; ++i)
+                probe[d].local_element(i) =
+                  d == comp && !fixed[i] && has_colour(coord[i]) ? 1. : 0.;
+            compute_forces(probe, force);
+            for (unsigned int i = 0; i < disc.n_owned(); ++i)
+              {
+                if (fixed[i])
+                  continue;
+                // the one node of this colour within the reach of row i
+                std::array<long long, dim> s;
+                bool                       inside = true;
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    s[d] = coord[i][d] - reach + ((cc[d] - (coord[i][d] - reach)) % P + P) % P;
+                    inside = inside && s[d] <= coord[i][d] + reach && s[d] >= 0;
+                  }
+                const auto it = inside ? global_of.find(key(s)) : global_of.end();
+                for (unsigned int a = 0; a < dim; ++a)
+                  {
+                    const double v = force[a].local_element(i);
+                    if (v == 0.)
+                      continue;
+                    AssertThrow(it != global_of.end() && !fixed_global[it->second],
+                                ExcMessage("WLS stiffness by probing: a force beyond the "
+                                           "two-hop reach of the probed node"));
+                    rows[dim * i + a][dim * it->second + comp] = -v;
+                  }
+              }
+          }
+      }
+    // prescribed rows: identity
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (fixed[i])
+        for (unsigned int a = 0; a < dim; ++a)
+          rows[dim * i + a][dim * (first + i) + a] = 1.;
+
+    const IndexSet                     owned = Stiffness::owned_dofs(disc);
+    TrilinosWrappers::SparsityPattern sp(owned, owned, mpi_communicator);
+    for (unsigned int r = 0; r < rows.size(); ++r)
+      for (const auto &[c, v] : rows[r])
+        sp.add(dim * first + r, c);
+    sp.compress();
+    matrix.reinit(sp);
+    for (unsigned int r = 0; r < rows.size(); ++r)
+      for (const auto &[c, v] : rows[r])
+        matrix.set(dim * first + r, c, v);
+    matrix.compress(VectorOperation::insert);
+  }
+
+  template <int dim>
+  void
   StaticMechanicsSolver<dim>::solve()
   {
     Timer                          timer;
@@ -301,11 +435,26 @@ namespace PeriDEAL
     Stiffness::to_dofs(disc, uc, x);
 
     SolverControl control(prm.max_iterations, prm.tolerance * rhs.l2_norm());
-    if (lps && lps->wls_quadrature())
+    if (lps && lps->wls_quadrature() && prm.solver == "direct")
+      {
+        // The WLS stiffness is non-symmetric and, for high orders on fine
+        // lattices (WLS-4 at m >= 6), its collocation misses the
+        // grid-scale modes that dominate the standard K: K_std^{-1} K_wls
+        // then has eigenvalues near 0 and GMRES preconditioned with K_std
+        // stalls (WLS-4, m = 6, 8: no convergence in 10000 iterations;
+        // m = 4: 6293). The direct factorization of the assembled K_wls has
+        // no such dependence on the spectrum.
+        assemble_by_probing(K);
+      }
+    else if (lps && lps->wls_quadrature())
       {
         // Matrix-free K x: fixed rows identity, fixed columns dropped, the
-        // free rows -f(x with the fixed entries zeroed); GMRES preconditioned
-        // with the standard-scheme stiffness K (same continuum operator).
+        // free rows -f(x with the fixed entries zeroed); GMRES with the AMG
+        // of the standard-scheme stiffness K (same continuum operator) as a
+        // right preconditioner, so that the stopping test is on the true
+        // residual ||b - K_wls x|| <= tolerance ||b|| (left preconditioning
+        // would test ||P^{-1} (b - K_wls x)||, a displacement-scaled norm
+        // that the force-scaled tolerance does not fit).
         VectorField xf, fx;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -337,36 +486,16 @@ namespace PeriDEAL
                            -fx[d].local_element(i);
           Stiffness::to_dofs(disc, fx, dst);
         };
-        SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData gmres_data(300);
+        SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData gmres_data(300, true);
         SolverGMRES<TrilinosWrappers::MPI::Vector> gmres(control, gmres_data);
-        if (prm.solver == "direct")
-          {
-            // The factorization of K as preconditioner.
-            SolverControl                  inner(1, 0.);
-            TrilinosWrappers::SolverDirect direct(inner);
-            direct.initialize(K);
-            struct Direct
-            {
-              TrilinosWrappers::SolverDirect *solver;
-              void
-              vmult(TrilinosWrappers::MPI::Vector &dst, const TrilinosWrappers::MPI::Vector &src) const
-              {
-                solver->solve(dst, src);
-              }
-            } prec{&direct};
-            gmres.solve(system, x, rhs, prec);
-          }
-        else
-          {
-            TrilinosWrappers::PreconditionAMG                 amg;
-            TrilinosWrappers::PreconditionAMG::AdditionalData data;
-            data.elliptic = true;
-            data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
-            for (unsigned int k = 0; k < owned.n_elements(); ++k)
-              data.constant_modes[k % dim][k] = true;
-            amg.initialize(K, data);
-            gmres.solve(system, x, rhs, amg);
-          }
+        TrilinosWrappers::PreconditionAMG                 amg;
+        TrilinosWrappers::PreconditionAMG::AdditionalData data;
+        data.elliptic = true;
+        data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
+        for (unsigned int k = 0; k < owned.n_elements(); ++k)
+          data.constant_modes[k % dim][k] = true;
+        amg.initialize(K, data);
+        gmres.solve(system, x, rhs, amg);
         iterations = control.last_step();
         system.vmult(res, x);
         res -= rhs;

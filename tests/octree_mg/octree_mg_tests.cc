@@ -9,6 +9,13 @@
 //  corrosion_2d / corrosion_3d: solid-volume history of the adaptive octree
 //    multi-grid against the uniform-fine (serial) model, with the
 //    uniform-coarse model as the scale of the discretization error;
+//  coarsening (also NPROCS 2): fine -> coarse switching by the smoothness
+//    indicator and by hand, mass through a fine -> coarse -> fine cycle to
+//    round-off, a linear field through the cycle unchanged, 1 vs n ranks;
+//  backward_euler (also NPROCS 2): node by node against the serial
+//    multi-grid's backward Euler (both couplings), first-order agreement
+//    with the explicit solver as dt -> 0, mass of the conservative coupling,
+//    1 vs n ranks;
 //  bad_input: ParameterErrors.
 
 #include <deal.II/base/timer.h>
@@ -449,6 +456,276 @@ namespace
     corrosion<3>(60, 5);
   }
 
+
+  // max |C_a - C_b| over two gathered node sets; false if the sets differ
+  bool
+  same_nodes(const std::vector<std::tuple<std::uint64_t, double, double>> &a,
+             const std::vector<std::tuple<std::uint64_t, double, double>> &b,
+             double                                                       &max_diff)
+  {
+    max_diff = 0.;
+    if (a.size() != b.size())
+      return false;
+    for (std::size_t q = 0; q < a.size(); ++q)
+      {
+        if (std::get<0>(a[q]) != std::get<0>(b[q]))
+          return false;
+        max_diff = std::max(max_diff, std::abs(std::get<1>(a[q]) - std::get<1>(b[q])));
+      }
+    return true;
+  }
+
+  // 2D diffusion of a narrow bump in [-6, 6]^2, delta = 1, dx+ = 0.5, dx- =
+  // 0.125 (octree cells of side 2), fine region the 2 x 2 cells around the
+  // bump (a union of octree cells, so that the serial multi-grid has it too)
+  MultiGrid::OctreeParameters<2>
+  bump_parameters(const bool conservative, const std::string &scheme)
+  {
+    MultiGrid::OctreeParameters<2> op;
+    op.grid             = box_parameters<2>(6., 1., 0.125);
+    op.grid.fine_region = MultiGrid::Region<2>::box(uniform_point<2>(-2.1), uniform_point<2>(1.6));
+    op.transport.kappa        = 1.;
+    op.transport.conservative = conservative;
+    op.transport.scheme       = scheme;
+    return op;
+  }
+
+  double
+  bump(const Point<2> &x)
+  {
+    return std::exp(-x.distance_square(Point<2>(0.5, -0.5)) / 0.5);
+  }
+
+  void
+  coarsening()
+  {
+    // (a) by hand: fine -> coarse -> fine with the conservative coupling,
+    // mass after every switch; a linear field through the cycle
+    auto run_cycle = [&](const MPI_Comm comm, double &max_jump, double &linear_dev,
+                         unsigned int &n_coarsened) {
+      auto op = bump_parameters(true, "forward Euler");
+      MultiGrid::OctreeMultiGrid<2> mg(comm, op);
+      mg.set_initial(bump);
+      double m = mg.mass();
+      max_jump = 0.;
+      auto note = [&]() {
+        max_jump = std::max(max_jump, std::abs(mg.mass() - m) / m);
+        m        = mg.mass();
+      };
+      for (unsigned int n = 0; n < 20; ++n)
+        mg.advance();
+      note();
+      // fine everywhere within 4 of the bump, then all coarse, then back
+      mg.set_fine_cells([](const Point<2> &c) { return c.distance(Point<2>(0.5, -0.5)) < 4.; });
+      note();
+      for (unsigned int n = 0; n < 20; ++n)
+        mg.advance();
+      note();
+      mg.set_fine_cells([](const Point<2> &) { return false; });
+      note();
+      for (unsigned int n = 0; n < 20; ++n)
+        mg.advance();
+      note();
+      mg.set_fine_cells([](const Point<2> &c) { return c.norm() < 3.; });
+      note();
+      n_coarsened = mg.n_coarsened();
+      const auto out = mg.gather();
+
+      // a linear field is kept by both transfers (cell means of a linear
+      // field are its values at the coarse nodes, the cell centres; the
+      // interpolation of (3.88) is exact for linear fields and the mean shift
+      // is then zero)
+      // (multilinear: inverse-distance weights are not linear-exact in 2D)
+      op.grid.interpolation = MultiGrid::Interpolation::multilinear;
+      MultiGrid::OctreeMultiGrid<2> lin(comm, op);
+      auto f = [](const Point<2> &x) { return 0.3 + 0.1 * x[0] - 0.05 * x[1]; };
+      lin.set_initial(f);
+      lin.set_fine_cells([](const Point<2> &) { return false; });
+      // fine cells away from the box's faces (beyond the outermost coarse
+      // nodes the coarse -> fine interpolation is clamped, not linear)
+      lin.set_fine_cells([](const Point<2> &c) { return c.norm() < 3.; });
+      linear_dev   = 0.;
+      const auto g = lin.gather();
+      // f at every lattice point of both grids, by node id
+      std::map<std::uint64_t, double> exact;
+      for (double x = -6.; x <= 6. + 1e-9; x += 0.5)
+        for (double y = -6.; y <= 6. + 1e-9; y += 0.5)
+          exact[lin.node_id(Point<2>(x, y), false)] = f(Point<2>(x, y));
+      for (double x = -6.25 + 0.0625; x < 6.25; x += 0.125)
+        for (double y = -6.25 + 0.0625; y < 6.25; y += 0.125)
+          exact[lin.node_id(Point<2>(x, y), true)] = f(Point<2>(x, y));
+      for (const auto &[id, c, ph] : g)
+        linear_dev = std::max(linear_dev, std::abs(c - exact.at(id)));
+      return out;
+    };
+    double       jump_n, lin_n, jump_1, lin_1;
+    unsigned int nc_n, nc_1;
+    const auto   all = run_cycle(MPI_COMM_WORLD, jump_n, lin_n, nc_n);
+    if (root())
+      {
+        const auto one = run_cycle(MPI_COMM_SELF, jump_1, lin_1, nc_1);
+        const unsigned int np = Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
+        std::cout << "  cycle on " << np << " ranks: " << nc_n << " cells coarsened, max relative "
+                  << "mass change per stage " << sci(jump_n) << " (1 rank: " << sci(jump_1)
+                  << "), linear field deviation " << sci(lin_n) << std::endl;
+        check(nc_n > 0, "cells returned from fine to coarse");
+        check(jump_n < 1e-13 && jump_1 < 1e-13,
+              "conservative coupling: mass through fine -> coarse -> fine to round-off: " +
+                sci(std::max(jump_n, jump_1)));
+        check(lin_n < 1e-14, "linear field unchanged by fine -> coarse -> fine: " + sci(lin_n));
+        double     diff;
+        const bool same = same_nodes(all, one, diff);
+        check(same && diff < 1e-13,
+              "the same nodes and values on " + std::to_string(np) + " ranks and 1 rank: " +
+                sci(diff));
+      }
+
+    // (b) by the indicator: the bump spreads, its cells first refine
+    // around it, then return to coarse once the field is flat
+    for (const bool conservative : {false, true})
+      {
+        auto op                 = bump_parameters(conservative, "forward Euler");
+        op.switching            = true;
+        op.coarsening           = true;
+        op.indicator_threshold  = 0.05;
+        op.coarsening_threshold = 0.02;
+        op.switching_interval   = 2;
+        MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, op);
+        mg.set_initial(bump);
+        const double m0 = mg.mass(), v0 = mg.active_volume();
+        const unsigned int n_fine0   = mg.n_fine_cells();
+        unsigned int       max_cells = n_fine0;
+        double             max_change = 0., m_prev = m0;
+        for (unsigned int n = 0; n < 300; ++n)
+          {
+            mg.advance();
+            max_cells  = std::max(max_cells, mg.n_fine_cells());
+            max_change = std::max(max_change, std::abs(mg.mass() - m_prev) / m0);
+            m_prev     = mg.mass();
+          }
+        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        if (root())
+          std::cout << "  " << tag << "fine cells max " << max_cells << ", at t = " << mg.time()
+                    << ": " << mg.n_fine_cells() << "; " << mg.n_coarsened()
+                    << " cells coarsened in " << mg.n_switches() << " switch events; max "
+                    << "relative mass change per step " << sci(max_change) << std::endl;
+        check(max_cells > n_fine0, tag + "coarse cells refined as the bump spread");
+        check(mg.n_coarsened() > 0 && mg.n_fine_cells() < max_cells,
+              tag + "fine cells returned to coarse once the bump had spread");
+        check_close(mg.active_volume(), v0, 1e-14, tag + "active volume counted once");
+        if (conservative)
+          check(max_change < 1e-13, tag + "mass to round-off at every step, switches included: " +
+                                      sci(max_change));
+      }
+  }
+
+  void
+  backward_euler()
+  {
+    const unsigned int np = Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
+    for (const bool conservative : {false, true})
+      {
+        const std::string tag = conservative ? "conservative: " : "interpolation: ";
+        // (a) against the serial multi-grid's backward Euler at 4x the
+        // explicit bound (unconditionally stable)
+        auto op = bump_parameters(conservative, "backward Euler");
+        double dt_fe;
+        {
+          const MultiGrid::Discretization<2> d(op.grid);
+          auto tp       = op.transport;
+          tp.scheme     = "forward Euler";
+          dt_fe         = MultiGrid::TransportSolver<2>(d, tp).critical_time_step();
+        }
+        op.transport.time_step = 4. * dt_fe;
+        MultiGrid::OctreeMultiGrid<2> mg(MPI_COMM_WORLD, op);
+        mg.set_initial(bump);
+        const double m0 = mg.mass();
+        for (unsigned int n = 0; n < 30; ++n)
+          mg.advance();
+        const double drift = std::abs(mg.mass() - m0) / m0;
+        const auto   mine  = mg.gather();
+        std::vector<double> serial_mass;
+        const auto serial = serial_run<2>(op.grid, op.transport, bump, 30, mg, serial_mass);
+        const auto single = [&]() {
+          if (np == 1 || !root())
+            return mine;
+          MultiGrid::OctreeMultiGrid<2> one(MPI_COMM_SELF, op);
+          one.set_initial(bump);
+          for (unsigned int n = 0; n < 30; ++n)
+            one.advance();
+          return one.gather();
+        }();
+        if (root())
+          {
+            double max_diff = 0., rank_diff = 0., cmax = 0.;
+            bool   same = mine.size() == serial.size();
+            for (const auto &[id, c, ph] : mine)
+              {
+                const auto it = serial.find(id);
+                same          = same && it != serial.end();
+                if (it != serial.end())
+                  max_diff = std::max(max_diff, std::abs(c - it->second));
+                cmax = std::max(cmax, std::abs(c));
+              }
+            const bool same_ranks = same_nodes(mine, single, rank_diff);
+            std::cout << "  " << tag << "backward Euler, dt = 4 x the explicit bound, 30 steps: "
+                      << "max |C_octree - C_serial| " << sci(max_diff) << ", max C " << cmax
+                      << ", relative mass drift " << sci(drift) << " (serial "
+                      << sci(std::abs(serial_mass.back() - serial_mass.front()) /
+                             serial_mass.front())
+                      << "), " << np << " vs 1 rank " << sci(rank_diff) << std::endl;
+            check(same, tag + "same active node set as the serial multi-grid");
+            // two direct solvers (Eigen SparseLU of the system with the
+            // fictitious unknowns, KLU with them eliminated): round-off
+            check(max_diff < 1e-12, tag + "backward Euler = serial multi-grid backward Euler: " +
+                                      sci(max_diff));
+            check(same_ranks && rank_diff < 1e-12,
+                  tag + std::to_string(np) + " ranks vs 1 rank: " + sci(rank_diff));
+            check(cmax <= 1. + 1e-12, tag + "no overshoot at 4x the explicit bound (max C " +
+                                        std::to_string(cmax) + ")");
+          }
+        if (conservative)
+          check(drift < 1e-12, tag + "backward Euler mass to round-off: " + sci(drift));
+
+        // (b) against the explicit solver: |C_BE - C_FE| at T = 0.4 is O(dt)
+        // (both first order, opposite error sign): halving dt halves it.
+        // Serial only (the 2-rank run checks the rank invariance above).
+        if (np > 1)
+          continue;
+        std::vector<double> gap;
+        for (const double f : {0.1, 0.05})
+          {
+            std::vector<std::vector<std::tuple<std::uint64_t, double, double>>> res;
+            for (const std::string scheme : {"backward Euler", "forward Euler"})
+              {
+                auto o                = bump_parameters(conservative, scheme);
+                o.transport.time_step = f * dt_fe;
+                MultiGrid::OctreeMultiGrid<2> s(MPI_COMM_WORLD, o);
+                s.set_initial(bump);
+                while (s.time() < 0.4 - 1e-9)
+                  s.advance();
+                res.push_back(s.gather());
+              }
+            double d = 0.;
+            if (root())
+              same_nodes(res[0], res[1], d);
+            gap.push_back(d);
+          }
+        if (root())
+          {
+            std::cout << "  " << tag << "max |C_BE - C_FE| at t = 0.4: " << sci(gap[0])
+                      << " (dt = 0.1 x bound), " << sci(gap[1]) << " (0.05 x bound), ratio "
+                      << gap[0] / gap[1] << std::endl;
+            // C(0) <= 1: within 1 % at the smaller step
+            check(gap[1] < 1e-2, tag + "backward and forward Euler agree at small dt: " +
+                                   sci(gap[1]));
+            check(gap[0] / gap[1] > 1.8 && gap[0] / gap[1] < 2.2,
+                  tag + "their difference is first order in dt (ratio " +
+                    std::to_string(gap[0] / gap[1]) + " in [1.8, 2.2])");
+          }
+      }
+  }
+
   void
   bad_input()
   {
@@ -471,8 +748,12 @@ namespace
     op.grid.interpolation  = MultiGrid::Interpolation::nearest_active;
     throws(op, "nearest-active interpolation");
     op                     = switching_parameters(c, true, 0.);
-    op.transport.scheme    = "backward Euler";
-    throws(op, "backward Euler");
+    op.transport.scheme    = "Crank-Nicolson";
+    throws(op, "Crank-Nicolson");
+    op                      = switching_parameters(c, true, 0.);
+    op.coarsening           = true;
+    op.coarsening_threshold = op.indicator_threshold;
+    throws(op, "coarsening threshold not below the indicator threshold");
     op                     = switching_parameters(c, true, 0.);
     op.indicator_threshold = 0.;
     throws(op, "indicator threshold 0");
@@ -494,5 +775,7 @@ main(int argc, char **argv)
               {"ranks", ranks},
               {"corrosion_2d", corrosion_2d},
               {"corrosion_3d", corrosion_3d},
+              {"coarsening", coarsening},
+              {"backward_euler", backward_euler},
               {"bad_input", bad_input}});
 }

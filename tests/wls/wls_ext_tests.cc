@@ -356,9 +356,13 @@ namespace
     return waves;
   }
 
+  // Relative l2 error of the static solution over the body; in @p consistency
+  // the truncation error of the scheme, ||f_h(u_exact) + b|| / ||b|| over the
+  // free nodes (the force of the exact field against the continuum's).
   double
   lps_m_error(const double delta, const unsigned int m, const std::string &q,
-              const unsigned int order, unsigned int *iterations = nullptr)
+              const unsigned int order, double &consistency, double &residual,
+              const std::string &linear_solver = "direct")
   {
     const auto waves = lps_plane_waves(delta);
     auto       exact = [waves](const Point<2> &x) {
@@ -368,6 +372,8 @@ namespace
       return u;
     };
     auto p       = lps_parameters(delta, m, q, order);
+    p.solver     = linear_solver;
+    p.tolerance  = 1e-11;
     p.body_force = [waves](const Point<2> &x) {
       Tensor<1, 2> b;
       for (const auto &w : waves)
@@ -377,10 +383,28 @@ namespace
     p.layer_displacement = exact;
     StaticMechanicsSolver<2> solver(MPI_COMM_WORLD, p);
     solver.setup();
-    solver.solve();
-    if (iterations)
-      *iterations = solver.n_iterations();
     const auto &disc = solver.discretization();
+    {
+      std::array<PeriDEAL::Vector, 2> ue, f;
+      fill(disc, ue, exact);
+      fill(disc, f, exact);
+      solver.compute_forces(ue, f);
+      double t2 = 0., b2 = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        if (!solver.fixed_nodes()[i])
+          {
+            const auto b = p.body_force(disc.position[i]);
+            for (unsigned int c = 0; c < 2; ++c)
+              {
+                t2 += std::pow(f[c].local_element(i) + b[c], 2);
+                b2 += b[c] * b[c];
+              }
+          }
+      consistency = std::sqrt(Utilities::MPI::sum(t2, MPI_COMM_WORLD) /
+                              Utilities::MPI::sum(b2, MPI_COMM_WORLD));
+    }
+    solver.solve();
+    residual = solver.relative_residual();
     double      e2 = 0., n2 = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (!solver.fixed_nodes()[i])
@@ -400,28 +424,38 @@ namespace
   {
     const double delta = 0.25;
     // The exact nonlocal solution of the continuum: the standard scheme's
-    // consistency check is that its error falls with m.
-    std::map<std::string, std::map<unsigned int, double>> err;
+    // consistency check is that its error falls with m; WLS-k is exact for
+    // polynomials of degree <= k (lps_polynomial), so for the plane waves its
+    // error is the polynomial-fit error of the fields over one horizon,
+    // O((|k| delta)^(k+1)) with |k| delta = 0.84, independent of m: a plateau.
+    // All WLS systems are solved by the direct factorization of the
+    // assembled (probed) WLS matrix; with the standard-K-preconditioned
+    // GMRES WLS-4 did not converge at m = 6, 8.
+    std::map<std::string, std::map<unsigned int, double>> err, tau;
     const std::vector<unsigned int> ms = {3, 4, 6, 8};
     auto run_case = [&](const std::string &name, const unsigned int m, const std::string &q,
                         const unsigned int order) {
-      unsigned int it = 0;
-      try
-        {
-          err[name][m] = lps_m_error(delta, m, q, order, &it);
-        }
-      catch (const std::exception &e)
-        {
-          // Reported, not hidden: the matrix-free GMRES did not converge.
-          err[name][m] = -1.;
-          if (root())
-            std::cout << "    " << name << ", m = " << m << ": no convergence" << std::endl;
-          return;
-        }
+      double res = 0.;
+      err[name][m] = lps_m_error(delta, m, q, order, tau[name][m], res);
       if (root())
-        std::cout << "    " << name << ", m = " << m << ": error " << sci(err[name][m]) << ", "
-                  << it << " iterations" << std::endl;
+        std::cout << "    " << name << ", m = " << m << ": error " << sci(err[name][m])
+                  << ", truncation error " << sci(tau[name][m]) << ", solver residual "
+                  << sci(res) << std::endl;
+      check(res < 1e-10, name + ", m = " + std::to_string(m) + ": linear system solved, residual " +
+                           sci(res));
     };
+    {
+      // the iterative path: GMRES, right-preconditioned with the AMG of the
+      // standard stiffness, stopping on the true residual
+      double t, res;
+      const double e = lps_m_error(delta, 4, "wls", 2, t, res, "cg-amg");
+      const double e_direct = lps_m_error(delta, 4, "wls", 2, t, t);
+      if (root())
+        std::cout << "    WLS-2, m = 4, GMRES + AMG: error " << sci(e) << ", residual "
+                  << sci(res) << " (direct: error " << sci(e_direct) << ")" << std::endl;
+      check(res < 1e-10 && std::abs(e - e_direct) < 1e-6 * e_direct,
+            "WLS-2, m = 4: GMRES + AMG reaches the direct solution");
+    }
     for (const unsigned int m : ms)
       {
         run_case("standard", m, "standard", 2);
@@ -432,15 +466,56 @@ namespace
     if (root())
       {
         std::cout << "    2D LPS m-convergence, delta = " << delta
-                  << ", relative l2 error over the body\n    m   standard   WLS-2      WLS-4\n";
+                  << ", relative l2 error over the body (truncation error)\n"
+                     "    m   standard              WLS-2                 WLS-4\n";
         for (const unsigned int m : ms)
-          std::cout << "    " << std::setw(2) << m << "  " << sci(err["standard"][m]) << "  "
-                    << sci(err["WLS-2"][m]) << "  "
-                    << (err["WLS-4"].count(m) ? sci(err["WLS-4"][m]) : std::string("-")) << "\n";
+          std::cout << "    " << std::setw(2) << m << "  " << sci(err["standard"][m]) << " ("
+                    << sci(tau["standard"][m]) << ")  " << sci(err["WLS-2"][m]) << " ("
+                    << sci(tau["WLS-2"][m]) << ")  "
+                    << (err["WLS-4"].count(m) ? sci(err["WLS-4"][m]) + " (" +
+                                                  sci(tau["WLS-4"][m]) + ")" :
+                                                std::string("-"))
+                    << "\n";
       }
     for (unsigned int k = 1; k < ms.size(); ++k)
       check(err["standard"][ms[k]] < err["standard"][ms[k - 1]],
             "standard error decreases with m (m = " + std::to_string(ms[k]) + ")");
+    // Plateaus: the WLS truncation errors vary by less than 25 % over m = 3..8
+    // (resp. 4..8) while the standard one falls (the fit error does not
+    // depend on the node count); the WLS-2 solution error likewise.
+    auto spread = [](const std::map<unsigned int, double> &e) {
+      double lo = 1e300, hi = 0.;
+      for (const auto &[m, v] : e)
+        lo = std::min(lo, v), hi = std::max(hi, v);
+      return hi / lo;
+    };
+    for (const std::string name : {"WLS-2", "WLS-4"})
+      check(spread(tau[name]) < 1.25,
+            name + ": truncation error plateaus (max/min over m " + sci(spread(tau[name])) +
+              " < 1.25)");
+    check(spread(err["WLS-2"]) < 1.25,
+          "WLS-2: solution error plateaus (max/min over m " + sci(spread(err["WLS-2"])) + ")");
+    check(tau["standard"][3] > 2. * tau["standard"][8],
+          "standard truncation error falls with m (m = 3: " + sci(tau["standard"][3]) +
+            ", m = 8: " + sci(tau["standard"][8]) + ")");
+    // Order: the 1D source (Table 3.1) reports WLS-4 about two orders below
+    // WLS-2; measured here 82-97x in the truncation error. Asserted: more
+    // than 1.5 orders (30x) at every m.
+    for (const unsigned int m : ms)
+      if (m >= 4)
+        check(tau["WLS-4"][m] < tau["WLS-2"][m] / 30.,
+              "m = " + std::to_string(m) + ": WLS-4 truncation error " + sci(tau["WLS-4"][m]) +
+                " < WLS-2's / 30 (" + sci(tau["WLS-2"][m]) + ")");
+    // The solution error is the truncation error times the stability
+    // constant of the non-symmetric WLS matrix; for WLS-4 that constant
+    // grows at m = 8 (error/truncation 1.2, 1.1, 3.7 at m = 4, 6, 8: the 49
+    // collocation nodes of a ~200-node family control the grid-scale modes
+    // less well), so only the ordering is asserted for the solution:
+    for (const unsigned int m : ms)
+      if (m >= 4)
+        check(err["WLS-4"][m] < err["WLS-2"][m] / 10.,
+              "m = " + std::to_string(m) + ": WLS-4 solution error " + sci(err["WLS-4"][m]) +
+                " < WLS-2's / 10 (" + sci(err["WLS-2"][m]) + ")");
   }
 
   // ------------------------------------------------------------------

@@ -77,6 +77,20 @@ namespace PeriDEAL
        */
       std::function<bool(const Point<dim> &)> initial_fine_region;
 
+      /**
+       * false: the coupling (3.85)-(3.88), whose forces are not pairwise (an
+       * active node's bond to a fictitious node has no reaction), so the
+       * momentum drifts. true: the reaction of every active-fictitious bond
+       * (the force the sweep computes on the fictitious end) is paid to the
+       * active nodes that define the fictitious node's displacement, with
+       * the interpolation weights (the transpose of (3.86)/(3.88), through
+       * the coarse fictitious corners of fine fictitious nodes), scaled by
+       * V_j / V_a: action = reaction, so the standard-scheme forces conserve
+       * linear momentum to round-off. Not with the adaptive hybrid model
+       * (ParameterError): its WLS rows are not pairwise.
+       */
+      bool conservative_coupling = false;
+
       /** Throws ParameterError naming the entry for inadmissible values. */
       void
       check() const;
@@ -350,6 +364,9 @@ namespace PeriDEAL
         /** The evaluated nodes (ascending) and their box positions. */
         std::vector<unsigned int> evaluated;
         std::vector<long>         evaluated_position;
+        /** Conservative coupling: the fictitious nodes (ascending box position) and their positions. */
+        std::vector<unsigned int> paid;
+        std::vector<long>         paid_position;
         /** x - x_c + u and reactions per box position, dim arrays of n_alloc. */
         std::vector<double> p, reaction;
         /** Scratch: (offset, position) of bonds broken in this sweep. */
@@ -389,6 +406,8 @@ namespace PeriDEAL
       std::vector<double> wls_weight;
       /** Stability limit of velocity Verlet with the WLS stencil (its symbol). */
       double wls_stable_step = 0.;
+      /** Conservative coupling: force density on the fictitious nodes (dim per node). */
+      std::array<std::vector<double>, 2> fictitious_force;
       /** Interpolation rows: node, then sources/weights (CSR) for each grid's fictitious list. */
       std::array<std::vector<unsigned int>, 2> interp_start, interp_source;
       std::array<std::vector<double>, 2>       interp_weight;
@@ -411,6 +430,9 @@ namespace PeriDEAL
       }
       void
       setup_wls();
+      /** Conservative coupling: the fictitious reactions to their active donors. */
+      void
+      pay_back_fictitious_forces();
       /** Rebuild active/fictitious lists and interpolation rows from @p refined. */
       void
       update_node_sets();
@@ -462,6 +484,8 @@ namespace PeriDEAL
       double         coarse_dx = 2., fine_dx = 1., delta = 8.;
       double         end_time  = 87.5e-6;
       Interpolation  interpolation = Interpolation::inverse_distance;
+      /** MechanicsParameters::conservative_coupling. */
+      bool conservative_coupling = false;
 
       MechanicsParameters<2>
       parameters() const;

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -26,8 +27,8 @@ namespace PeriDEAL
      * kernel, interpolation and the initial fine region of the serial
      * multi-grid (MultiGrid::Parameters; here the fine region is a union of
      * octree cells), its transport model (MultiGrid::TransportParameters,
-     * forward Euler and the standard quadrature only), and the switching of
-     * cells from coarse to fine.
+     * forward or backward Euler, the standard quadrature only), and the
+     * switching of cells from coarse to fine and back.
      */
     template <int dim>
     struct OctreeParameters
@@ -39,12 +40,22 @@ namespace PeriDEAL
        * critical when the range max C - min C over its active nodes exceeds
        * @p indicator_threshold (a front or a steep gradient has arrived);
        * critical cells and their neighbours (a buffer of one cell, so that
-       * the front moves on into an already fine region) become fine. Fine
-       * cells stay fine.
+       * the front moves on into an already fine region) become fine.
        */
       bool         switching           = false;
       double       indicator_threshold = 0.05;
       unsigned int switching_interval  = 10; ///< steps between indicator evaluations
+      /**
+       * With switching, also return fine cells to coarse once the field
+       * there is smooth again (the front has passed): a fine cell becomes
+       * coarse when it and all its neighbours have max C - min C <
+       * @p coarsening_threshold and hold one phase only. The threshold must
+       * be below indicator_threshold (hysteresis: a cell that just
+       * coarsened is not critical at the next evaluation), and the
+       * neighbour rule keeps the one-cell buffer around critical cells.
+       */
+      bool   coarsening           = false;
+      double coarsening_threshold = 0.01;
 
       /** Throws ParameterError for inadmissible values. */
       void
@@ -85,10 +96,22 @@ namespace PeriDEAL
      * coarse grid, shifted per coarse cell so that the mean of its r^dim
      * fine values is the coarse value (the switch conserves mass to
      * round-off; linear fields are unchanged by the shift); phase:
-     * interpolated, solid iff >= 1/2. The mesh is then
+     * interpolated, solid iff >= 1/2. With coarsening, a smooth fine cell
+     * becomes coarse and each coarse node takes the mean of the r^dim fine
+     * values of its coarse cell (V+ = r^dim V-: the mass of the cell is
+     * kept to round-off), phase: solid iff the mean phase >= 1/2. The mesh is then
      * repartitioned with weight (1 + bonds of the cell's active nodes), the
      * node values travel with their cell (register_data_attach), and the
      * numbering, ghosts, bonds and interpolation are rebuilt.
+     *
+     * Backward Euler (TransportParameters::scheme): (M/dt - L) C^{n+1} = M
+     * C^n / dt with L the operator of the active rows in which every
+     * fictitious value is replaced by its interpolation from active nodes,
+     * i.e. the system (3.89)-(3.90) with the fictitious unknowns eliminated
+     * (the same solution); phase of t^n (frozen, as the serial solver). It
+     * is assembled into a distributed Trilinos matrix (pay-back entries of
+     * the conservative coupling into ghost rows) and factorized with Amesos
+     * KLU, once per grid and phase pattern.
      */
     template <int dim>
     class OctreeMultiGrid
@@ -109,7 +132,7 @@ namespace PeriDEAL
         initialize_phase();
       }
 
-      /** One forward Euler step; with switching, adapt() every interval. */
+      /** One forward or backward Euler step; with switching, adapt() every interval. */
       void
       advance();
 
@@ -120,6 +143,14 @@ namespace PeriDEAL
        */
       unsigned int
       adapt();
+
+      /**
+       * Set the fine/coarse flag of every cell to @p fine(centre of the
+       * cell) and transfer the values (both directions, as adapt()).
+       * Returns the number of cells that changed. Collective.
+       */
+      unsigned int
+      set_fine_cells(const std::function<bool(const Point<dim> &)> &fine);
 
       /** @name Global quantities (collective) */
       /** @{ */
@@ -143,6 +174,12 @@ namespace PeriDEAL
       n_switches() const
       {
         return n_switch_events;
+      }
+      /** Cells returned from fine to coarse so far. */
+      unsigned int
+      n_coarsened() const
+      {
+        return n_coarsened_cells;
       }
       /** @} */
 
@@ -192,6 +229,20 @@ namespace PeriDEAL
       refresh_work();
       void
       apply(LinearAlgebra::distributed::Vector<double> &rate) const;
+      /**
+       * The entries (row, column, value) of L on the local active nodes,
+       * fictitious columns expanded to their active sources, duplicates not
+       * merged; rows are owned or (pay-back) ghost nodes. kappa: the bond's
+       * or, with @p kappa_max, the largest one.
+       */
+      template <typename F>
+      void
+      operator_entries(const bool kappa_max, const F &emit) const;
+      /** Switch to @p new_fine: values, repartition, rebuild; returns the cells changed. */
+      unsigned int
+      transfer(const std::vector<char> &new_fine);
+      void
+      implicit_step();
       void
       compute_time_step_bound();
       long long
@@ -236,7 +287,9 @@ namespace PeriDEAL
       LinearAlgebra::distributed::Vector<double> C, phase, rate;
       std::vector<double> work_c, work_phase; ///< local active + fictitious values
       double       dt = 0., dt_critical = 0., t = 0.;
-      unsigned int n_step = 0, n_switch_events = 0;
+      unsigned int n_step = 0, n_switch_events = 0, n_coarsened_cells = 0;
+      struct Implicit;
+      std::unique_ptr<Implicit> implicit; ///< backward Euler system and factorization
       std::unordered_map<long long, std::vector<double>> incoming; ///< transfer buffer
     };
   } // namespace MultiGrid

@@ -45,7 +45,13 @@ namespace PeriDEAL
     /** Further node sets {level set <= 0} of the body with prescribed displacement. */
     std::vector<std::pair<std::function<double(const Point<dim> &)>, Field>>
       prescribed_displacements;
-    /** "cg-amg" (CG with ML AMG) or "direct" (Amesos KLU). */
+    /**
+     * "cg-amg" (CG with ML AMG) or "direct" (Amesos KLU). With quadrature
+     * = wls: "cg-amg" is matrix-free GMRES with the AMG of the standard
+     * stiffness as right preconditioner, "direct" factorizes the WLS matrix
+     * assembled by probing (robust where the WLS spectrum is far from the
+     * standard one, e.g. WLS-4 at m >= 6).
+     */
     std::string  solver = "cg-amg";
     double       tolerance = 1e-10;
     unsigned int max_iterations = 10000;
@@ -153,6 +159,16 @@ namespace PeriDEAL
     /** @} */
 
   private:
+    /**
+     * The system matrix of the free unknowns with the WLS force rows
+     * (non-symmetric, no bond structure), recovered from compute_forces()
+     * by probing with one colour class of nodes per evaluation; prescribed
+     * rows and columns removed, unit diagonal. Collective; every rank holds
+     * the (node, global index) table, meant for the sizes of static tests.
+     */
+    void
+    assemble_by_probing(TrilinosWrappers::SparseMatrix &matrix);
+
     MPI_Comm                                     mpi_communicator;
     StaticMechanicsParameters<dim>               prm;
     Discretization<dim>                          disc;
