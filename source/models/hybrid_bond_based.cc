@@ -597,6 +597,9 @@ namespace PeriDEAL
     // Lanes per vector of 8 box positions, and the vectors that have any.
     standard_lanes.assign(sweep_n_vectors, 0);
     shared_lanes.assign(sweep_n_vectors, 0);
+    wls_lanes.assign(sweep_n_vectors, 0);
+    for (const unsigned int i : active_wls_rows)
+      wls_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
     for (const unsigned int i : standard_rows)
       standard_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
     for (const unsigned int i : active_wls_rows)
@@ -693,19 +696,46 @@ namespace PeriDEAL
       return false;
     critical.compress(VectorOperation::add); // marks of ghost end points to their owners
     critical.update_ghost_values();
-    bool changed = false;
-    for (const unsigned int i : active_wls_rows)
+    bool       changed = false;
+    const auto switch_node = [&](const unsigned int i) {
+      if (wls_flag.local_element(i) > 0.5)
+        {
+          wls_flag.local_element(i) = 0.;
+          switched_at[i]            = int(n_evaluations) - 1;
+          changed                   = true;
+        }
+    };
+    if (sweep_on)
       {
-        bool hit = crit[i] > 0.;
-        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !hit; ++b)
-          hit = crit[nb.col[b]] > 0.;
-        if (hit)
-          {
-            wls_flag.local_element(i) = 0.;
-            switched_at[i]            = int(n_evaluations) - 1;
-            changed                   = true;
-          }
+        // The families of the (few) critical nodes, owned or ghost, by the
+        // lattice offsets: the family of a node is every node at a stencil
+        // offset (families are symmetric), so i switches iff i or a node
+        // of its family is critical, as below.
+        const std::int64_t n_box = 8 * std::int64_t(sweep_n_vectors);
+        const unsigned int n_owned = disc.n_owned();
+        for (std::size_t c = 0; c < disc.position.size(); ++c)
+          if (crit[c] > 0.)
+            {
+              if (c < n_owned)
+                switch_node(c);
+              for (const std::int64_t o : sweep_offset)
+                {
+                  const std::int64_t L = sweep_position[c] + o;
+                  if (L >= 0 && L < n_box && sweep_node[L] >= 0 &&
+                      sweep_node[L] < std::int32_t(n_owned))
+                    switch_node(sweep_node[L]);
+                }
+            }
       }
+    else
+      for (const unsigned int i : active_wls_rows)
+        {
+          bool hit = crit[i] > 0.;
+          for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !hit; ++b)
+            hit = crit[nb.col[b]] > 0.;
+          if (hit)
+            switch_node(i);
+        }
     critical = 0.;
     critical.zero_out_ghost_values();
     wls_flag.update_ghost_values();
@@ -730,10 +760,18 @@ namespace PeriDEAL
         if (needed)
           test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
       }
+    // A vector costs the same for one lane as for eight: test (and record)
+    // every Omega_w lane of a vector with one to test. An exact test of a
+    // node whose bound has not fired finds nothing critical at it (that is
+    // what the bound proves), so the outcome is unchanged; its record only
+    // restarts its budget.
     test_vectors.clear();
     for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
       if (test_lanes[v])
-        test_vectors.push_back(v);
+        {
+          test_lanes[v] = wls_lanes[v];
+          test_vectors.push_back(v);
+        }
     const std::size_t   N  = sweep_n_alloc, nv = sweep_n_vectors;
     const double       *p  = sweep_p.data() + sweep_pad;
     const unsigned int  n_f = sweep_offset.size(), n_classes = class_bound.size();

@@ -407,7 +407,7 @@ namespace PeriDEAL
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
     /** Per vector: lanes of owned Omega_s nodes, of shared-pattern WLS rows, to be tested. */
-    std::vector<std::uint8_t>  standard_lanes, shared_lanes, test_lanes;
+    std::vector<std::uint8_t>  standard_lanes, shared_lanes, wls_lanes, test_lanes;
     std::vector<std::uint32_t> standard_vectors, shared_vectors, test_vectors;
     /** Bonds broken by the sweep: (full offset, box position of the row). */
     std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
