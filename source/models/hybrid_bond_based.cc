@@ -324,122 +324,128 @@ namespace PeriDEAL
   {
     sweep_on = false;
 #ifdef PERIDEAL_HYBRID_SWEEP
-    const auto        &nb      = disc.neighborhood;
-    const std::size_t  n_local = disc.position.size();
-    const unsigned int n_owned = disc.n_owned();
-    if (dim == 1 || n_owned == 0 || disc.lattice_index.size() != n_local)
-      return;
-    box_radius = 0;
-    for (unsigned int i = 0; i < n_owned; ++i)
-      for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
-        for (unsigned int d = 0; d < dim; ++d)
-          box_radius = std::max(box_radius, std::abs(disc.lattice_index[nb.col[b]][d] -
-                                                     disc.lattice_index[i][d]));
-    std::array<int, dim> upper;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        sweep_lower[d] = std::numeric_limits<int>::max();
-        upper[d]       = std::numeric_limits<int>::min();
-      }
-    for (const auto &li : disc.lattice_index)
+    // Every rank decides (the shared pattern below is collective).
+    std::int64_t n_box    = 1;
+    const bool   local_ok = [&]() -> bool {
+      const auto        &nb      = disc.neighborhood;
+      const std::size_t  n_local = disc.position.size();
+      const unsigned int n_owned = disc.n_owned();
+      if (dim == 1 || n_owned == 0 || disc.lattice_index.size() != n_local)
+        return false;
+      box_radius = 0;
+      for (unsigned int i = 0; i < n_owned; ++i)
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          for (unsigned int d = 0; d < dim; ++d)
+            box_radius = std::max(box_radius, std::abs(disc.lattice_index[nb.col[b]][d] -
+                                                       disc.lattice_index[i][d]));
+      std::array<int, dim> upper;
       for (unsigned int d = 0; d < dim; ++d)
         {
-          sweep_lower[d] = std::min(sweep_lower[d], li[d]);
-          upper[d]       = std::max(upper[d], li[d]);
+          sweep_lower[d] = std::numeric_limits<int>::max();
+          upper[d]       = std::numeric_limits<int>::min();
         }
-    std::int64_t n_box = 1;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        sweep_stride[d] = n_box;
-        n_box *= upper[d] - sweep_lower[d] + 1;
-      }
-    if (n_box > 8 * std::int64_t(n_local) + 4096 || n_box > (std::int64_t(1) << 30))
-      return;
-    const int          W   = 2 * box_radius + 1;
-    const unsigned int n_q = std::pow(W, dim);
-    const auto linear = [&](unsigned int q) {
-      std::int64_t o = 0;
-      for (unsigned int d = 0; d < dim; ++d, q /= W)
-        o += std::int64_t(int(q % W) - box_radius) * sweep_stride[d];
-      return o;
-    };
-    // The full offsets that occur, each with one stiffness and length (else
-    // no sweep); the mirror of each too (its bits are cleared on breaking).
-    sweep_of_box.assign(n_q, -1);
-    sweep_offset.clear();
-    sweep_box.clear();
-    sweep_k.clear();
-    sweep_r.clear();
-    const double *coef = op.bond_coefficients().data();
-    const auto    add  = [&](const unsigned int q, const double k, const double r) {
-      sweep_of_box[q] = sweep_offset.size();
-      sweep_offset.push_back(linear(q));
-      sweep_box.push_back(q);
-      sweep_k.push_back(k);
-      sweep_r.push_back(r);
-    };
-    bool table_checked = false;
-    for (unsigned int i = 0; i < n_owned; ++i)
-      {
-        const std::uint64_t begin = nb.row_start[i], n = nb.row_start[i + 1] - begin;
-        const bool          regular = nb.table_start[i] == 0 && n == nb.stencil_size;
-        if (regular && table_checked)
-          continue;
-        for (std::uint64_t e = 0; e < n; ++e)
+      for (const auto &li : disc.lattice_index)
+        for (unsigned int d = 0; d < dim; ++d)
           {
-            const unsigned int  q = box_index(i, begin + e);
-            const std::uint64_t t = nb.table_start[i] + e;
-            if (sweep_of_box[q] < 0)
-              add(q, coef[t], nb.bond_length[t]);
-            else if (sweep_k[sweep_of_box[q]] != coef[t] || sweep_r[sweep_of_box[q]] != nb.bond_length[t])
-              return;
+            sweep_lower[d] = std::min(sweep_lower[d], li[d]);
+            upper[d]       = std::max(upper[d], li[d]);
           }
-        table_checked = table_checked || regular;
-      }
-    for (unsigned int f = 0, n = sweep_offset.size(); f < n; ++f)
-      if (sweep_of_box[n_q - 1 - sweep_box[f]] < 0)
-        add(n_q - 1 - sweep_box[f], sweep_k[f], sweep_r[f]);
-    // A row sums its bonds in the order of the offsets: the box index order
-    // (the same on every rank).
-    {
-      std::vector<unsigned int> order(sweep_offset.size());
-      for (unsigned int f = 0; f < order.size(); ++f)
-        order[f] = f;
-      std::sort(order.begin(), order.end(),
-                [&](const unsigned int a, const unsigned int b) { return sweep_box[a] < sweep_box[b]; });
-      const auto permute = [&](auto &v) {
-        auto w = v;
-        for (unsigned int f = 0; f < order.size(); ++f)
-          v[f] = w[order[f]];
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          sweep_stride[d] = n_box;
+          n_box *= upper[d] - sweep_lower[d] + 1;
+        }
+      if (n_box > 8 * std::int64_t(n_local) + 4096 || n_box > (std::int64_t(1) << 30))
+        return false;
+      const int          W   = 2 * box_radius + 1;
+      const unsigned int n_q = std::pow(W, dim);
+      const auto linear = [&](unsigned int q) {
+        std::int64_t o = 0;
+        for (unsigned int d = 0; d < dim; ++d, q /= W)
+          o += std::int64_t(int(q % W) - box_radius) * sweep_stride[d];
+        return o;
       };
-      permute(sweep_offset);
-      permute(sweep_box);
-      permute(sweep_k);
-      permute(sweep_r);
-      for (unsigned int f = 0; f < sweep_box.size(); ++f)
-        sweep_of_box[sweep_box[f]] = f;
-    }
-    const unsigned int n_f = sweep_offset.size();
-    sweep_mirror.resize(n_f);
-    sweep_L2.resize(n_f);
-    sweep_iL2.resize(n_f);
-    sweep_B2.resize(n_f);
-    sweep_class.resize(n_f);
-    for (unsigned int f = 0; f < n_f; ++f)
+      // The full offsets that occur, each with one stiffness and length (else
+      // no sweep); the mirror of each too (its bits are cleared on breaking).
+      sweep_of_box.assign(n_q, -1);
+      sweep_offset.clear();
+      sweep_box.clear();
+      sweep_k.clear();
+      sweep_r.clear();
+      const double *coef = op.bond_coefficients().data();
+      const auto    add  = [&](const unsigned int q, const double k, const double r) {
+        sweep_of_box[q] = sweep_offset.size();
+        sweep_offset.push_back(linear(q));
+        sweep_box.push_back(q);
+        sweep_k.push_back(k);
+        sweep_r.push_back(r);
+      };
+      bool table_checked = false;
+      for (unsigned int i = 0; i < n_owned; ++i)
+        {
+          const std::uint64_t begin = nb.row_start[i], n = nb.row_start[i + 1] - begin;
+          const bool          regular = nb.table_start[i] == 0 && n == nb.stencil_size;
+          if (regular && table_checked)
+            continue;
+          for (std::uint64_t e = 0; e < n; ++e)
+            {
+              const unsigned int  q = box_index(i, begin + e);
+              const std::uint64_t t = nb.table_start[i] + e;
+              if (sweep_of_box[q] < 0)
+                add(q, coef[t], nb.bond_length[t]);
+              else if (sweep_k[sweep_of_box[q]] != coef[t] || sweep_r[sweep_of_box[q]] != nb.bond_length[t])
+                return false;
+            }
+          table_checked = table_checked || regular;
+        }
+      for (unsigned int f = 0, n = sweep_offset.size(); f < n; ++f)
+        if (sweep_of_box[n_q - 1 - sweep_box[f]] < 0)
+          add(n_q - 1 - sweep_box[f], sweep_k[f], sweep_r[f]);
+      // A row sums its bonds in the order of the offsets: the box index order
+      // (the same on every rank).
       {
-        sweep_mirror[f] = sweep_of_box[n_q - 1 - sweep_box[f]];
-        // The thresholds of the CSR tables (the same expressions of r).
-        const double r = sweep_r[f];
-        sweep_L2[f]    = std::isfinite(s0) ? std::pow(r * (1. + prm.sigma * s0), 2) :
-                                             std::numeric_limits<double>::infinity();
-        sweep_B2[f]    = std::isfinite(s0) ? std::pow(r * (1. + s0), 2) :
-                                             std::numeric_limits<double>::infinity();
-        sweep_iL2[f]   = 1. / sweep_L2[f];
-        unsigned int k = 0;
-        while (k + 1 < class_bound.size() && r > class_bound[k])
-          ++k;
-        sweep_class[f] = k;
+        std::vector<unsigned int> order(sweep_offset.size());
+        for (unsigned int f = 0; f < order.size(); ++f)
+          order[f] = f;
+        std::sort(order.begin(), order.end(),
+                  [&](const unsigned int a, const unsigned int b) { return sweep_box[a] < sweep_box[b]; });
+        const auto permute = [&](auto &v) {
+          auto w = v;
+          for (unsigned int f = 0; f < order.size(); ++f)
+            v[f] = w[order[f]];
+        };
+        permute(sweep_offset);
+        permute(sweep_box);
+        permute(sweep_k);
+        permute(sweep_r);
+        for (unsigned int f = 0; f < sweep_box.size(); ++f)
+          sweep_of_box[sweep_box[f]] = f;
       }
+      const unsigned int n_f = sweep_offset.size();
+      sweep_mirror.resize(n_f);
+      sweep_L2.resize(n_f);
+      sweep_iL2.resize(n_f);
+      sweep_B2.resize(n_f);
+      sweep_class.resize(n_f);
+      for (unsigned int f = 0; f < n_f; ++f)
+        {
+          sweep_mirror[f] = sweep_of_box[n_q - 1 - sweep_box[f]];
+          // The thresholds of the CSR tables (the same expressions of r).
+          const double r = sweep_r[f];
+          sweep_L2[f]    = std::isfinite(s0) ? std::pow(r * (1. + prm.sigma * s0), 2) :
+                                               std::numeric_limits<double>::infinity();
+          sweep_B2[f]    = std::isfinite(s0) ? std::pow(r * (1. + s0), 2) :
+                                               std::numeric_limits<double>::infinity();
+          sweep_iL2[f]   = 1. / sweep_L2[f];
+          unsigned int k = 0;
+          while (k + 1 < class_bound.size() && r > class_bound[k])
+            ++k;
+          sweep_class[f] = k;
+        }
+      return true;
+    }();
+    if (Utilities::MPI::min(int(local_ok), disc.get_mpi_communicator()) == 0)
+      return;
     setup_shared_pattern();
 
     std::int64_t reach = 8;
@@ -450,6 +456,7 @@ namespace PeriDEAL
     sweep_pad       = 8 * std::size_t((reach + 7) / 8);
     sweep_n_vectors = (n_box + 7) / 8;
     sweep_n_alloc   = 2 * sweep_pad + 8 * sweep_n_vectors + 8;
+    const std::size_t n_local = disc.position.size();
     sweep_position.resize(n_local);
     sweep_node.assign(8 * sweep_n_vectors, -1);
     for (std::size_t i = 0; i < n_local; ++i)
@@ -703,6 +710,9 @@ namespace PeriDEAL
           wls_flag.local_element(i) = 0.;
           switched_at[i]            = int(n_evaluations) - 1;
           changed                   = true;
+          // A node never returns to Omega_w: its bound need not grow.
+          for (auto &b : budget)
+            b.record(i, -1.);
         }
     };
     if (sweep_on)
