@@ -1,5 +1,6 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/hybrid_bond_based.h>
+#include <perideal/models/pmb_bond.h>
 
 #include <ctime>
 #include <immintrin.h>
@@ -120,33 +121,6 @@ namespace PeriDEAL
     }
 
 #ifdef PERIDEAL_HYBRID_SWEEP
-    /**
-     * The PMB bond of eight lanes from l2 = |y|^2: brk gets the alive lanes
-     * with l - r > s0 r (2.34); returns k (l - r) / l for the alive,
-     * unbroken lanes, 0 else. 1/l by vrsqrt14pd and two Newton steps, the
-     * arithmetic of BondBasedOperator's AVX-512 loops (bond_based.cc,
-     * pmb_bond_scale), so both schemes break a bond at the same stretch.
-     */
-    inline __m512d
-    bond_scale(__m512d        l2,
-               const __mmask8 alive,
-               const __m512d  rb,
-               const __m512d  kb,
-               const __m512d  s0r,
-               __mmask8      &brk)
-    {
-      l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-      const __m512d h = _mm512_mul_pd(_mm512_set1_pd(0.5), l2);
-      __m512d       inv = _mm512_rsqrt14_pd(l2);
-      for (unsigned int it = 0; it < 2; ++it)
-        inv = _mm512_mul_pd(inv,
-                            _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv), _mm512_set1_pd(1.5)));
-      const __m512d  dl   = _mm512_fmsub_pd(l2, inv, rb);
-      const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_LE_OQ);
-      brk                 = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_GT_OQ);
-      return _mm512_maskz_mul_pd(keep, _mm512_mul_pd(kb, dl), inv);
-    }
-
     /**
      * y = p(L + o) - p(L) of the eight positions L0..L0+7 (dim arrays of
      * stride N) and l2 = |y|^2 by the expression of length2().
@@ -874,7 +848,7 @@ namespace PeriDEAL
             const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
             const __m512d rb = _mm512_set1_pd(sweep_r[f]);
             __mmask8      brk;
-            const __m512d scale = bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
+            const __m512d scale = internal::pmb_bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
                                              _mm512_mul_pd(_mm512_set1_pd(s0), rb), brk);
             for (unsigned int d = 0; d < dim; ++d)
               acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);

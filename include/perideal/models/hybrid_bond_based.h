@@ -96,6 +96,18 @@ namespace PeriDEAL
    * critical, and only then are the critical flags and the new schemes sent
    * to the ghosts.
    *
+   * Lattice sweeps (AVX-512, dim > 1, uniform bonds per lattice offset,
+   * uses_lattice_sweep()): p = x - x_c + u and u are laid out over the box
+   * of lattice positions and every row runs over the (signed) stencil
+   * offsets, eight consecutive positions at a time, with per-offset bits
+   * for the unbroken bonds: the Omega_s rows (PMB force and breaking, the
+   * arithmetic of BondBasedOperator's AVX-512 loops), the exact switching
+   * test (every Omega_w lane of a vector with a lane whose bound fired) and
+   * the WLS rows of the interior collocation pattern, which share one set
+   * of weights (those of the row of lowest id; rows whose own weights
+   * differ, near boundaries, keep them). A row sums its bonds in a fixed
+   * offset order, so that results do not depend on the partition.
+   *
    * The WLS rows of all initial Omega_w nodes are computed once at
    * construction; a switched node just stops using its row. Damage,
    * strain energy (bond energies (2.26) for every node, a diagnostic) and
