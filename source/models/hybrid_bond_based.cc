@@ -1,5 +1,6 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/hybrid_bond_based.h>
+#include <perideal/models/pmb_bond.h>
 
 #include <ctime>
 #include <immintrin.h>
@@ -8,6 +9,10 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
+#  define PERIDEAL_HYBRID_SWEEP 1
+#endif
 
 namespace PeriDEAL
 {
@@ -115,111 +120,22 @@ namespace PeriDEAL
       return count;
     }
 
-#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
-    /** y = p_j - p_i of bonds b..b+7 (masked lanes read p_i itself). */
-    inline void
-    gather_y2(const double *p, const double *pi, const std::int32_t *col, const unsigned int b,
-              const __mmask8 m, __m512d &y0, __m512d &y1)
+#ifdef PERIDEAL_HYBRID_SWEEP
+    /**
+     * y = p(L + o) - p(L) of the eight positions L0..L0+7 (dim arrays of
+     * stride N) and l2 = |y|^2 by the expression of length2().
+     */
+    template <int dim>
+    inline __m512d
+    lane_bonds(const double *p, const std::size_t N, const std::size_t L0, const std::int64_t o,
+               const __m512d *pi, __m512d *y)
     {
-      const __m256i j2 = _mm256_slli_epi32(_mm256_maskz_loadu_epi32(m, col + b), 1);
-      const __m512d x0 = _mm512_set1_pd(pi[0]), x1 = _mm512_set1_pd(pi[1]);
-      y0 = _mm512_sub_pd(_mm512_mask_i32gather_pd(x0, m, j2, p, 8), x0);
-      y1 = _mm512_sub_pd(_mm512_mask_i32gather_pd(x1, m, j2, p + 1, 8), x1);
-    }
-
-    /** pmb_row<2> with AVX-512: the same expressions, eight bonds at a time. */
-    unsigned int
-    pmb_row_avx512(const double       *p,
-                   const double       *pi,
-                   const std::int32_t *col,
-                   const double       *k,
-                   const double       *r,
-                   std::uint8_t       *br,
-                   const unsigned int  n,
-                   const double        s0,
-                   double             *f)
-    {
-      __m512d       a0 = _mm512_setzero_pd(), a1 = _mm512_setzero_pd();
-      const __m512d vs0     = _mm512_set1_pd(s0);
-      unsigned int  n_break = 0;
-      for (unsigned int b = 0; b < n; b += 8)
-        {
-          const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
-          const __mmask8 alive =
-            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128());
-          if (alive == 0)
-            continue;
-          __m512d y0, y1;
-          gather_y2(p, pi, col, b, alive, y0, y1);
-          const __m512d l2 =
-            _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.),
-                                 _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0)));
-          const __m512d  l   = _mm512_sqrt_pd(l2);
-          const __m512d  rb  = _mm512_maskz_loadu_pd(alive, r + b);
-          const __m512d  dl  = _mm512_sub_pd(l, rb);
-          const __mmask8 brk = _mm512_mask_cmp_pd_mask(alive, dl, _mm512_mul_pd(vs0, rb), _CMP_GT_OQ);
-          const __mmask8 live = alive & ~brk;
-          const __m512d  scale =
-            _mm512_maskz_div_pd(live, _mm512_mul_pd(_mm512_maskz_loadu_pd(live, k + b), dl), l);
-          a0 = _mm512_fmadd_pd(scale, y0, a0);
-          a1 = _mm512_fmadd_pd(scale, y1, a1);
-          if (brk)
-            {
-              _mm_mask_storeu_epi8(br + b, brk, _mm_set1_epi8(1));
-              n_break += __builtin_popcount(brk);
-            }
-        }
-      f[0] += _mm512_reduce_add_pd(a0);
-      f[1] += _mm512_reduce_add_pd(a1);
-      return n_break;
-    }
-
-    /** test_row<2> with AVX-512: the same expressions, eight bonds at a time. */
-    unsigned int
-    test_row_avx512(const double       *p,
-                    const double       *pi,
-                    const std::int32_t *col,
-                    const double       *L2,
-                    const double       *iL2,
-                    const double       *r,
-                    const double       *bound,
-                    const unsigned int  n_classes,
-                    const std::uint8_t *br,
-                    const unsigned int  n,
-                    double             *q)
-    {
-      unsigned int count = 0;
-      __m512d      qmax[max_classes];
-      for (unsigned int k = 0; k < max_classes; ++k)
-        qmax[k] = _mm512_setzero_pd();
-      for (unsigned int b = 0; b < n; b += 8)
-        {
-          const __mmask8 m = n - b >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - b)) - 1u);
-          const __mmask8 alive =
-            _mm_mask_cmpeq_epi8_mask(m, _mm_maskz_loadu_epi8(m, br + b), _mm_setzero_si128());
-          if (alive == 0)
-            continue;
-          __m512d y0, y1;
-          gather_y2(p, pi, col, b, alive, y0, y1);
-          const __m512d l2 = _mm512_fmadd_pd(y1, y1, _mm512_mul_pd(y0, y0));
-          count += __builtin_popcount(
-            _mm512_mask_cmp_pd_mask(alive, l2, _mm512_maskz_loadu_pd(alive, L2 + b), _CMP_GE_OQ));
-          const __m512d ratio = _mm512_mul_pd(l2, _mm512_maskz_loadu_pd(alive, iL2 + b));
-          const __m512d rb    = _mm512_maskz_loadu_pd(alive, r + b);
-          __mmask8      rest  = alive;
-          for (unsigned int k = 0; k < n_classes; ++k)
-            {
-              const __mmask8 in =
-                k + 1 < n_classes ?
-                  __mmask8(rest & _mm512_cmp_pd_mask(rb, _mm512_set1_pd(bound[k]), _CMP_LE_OQ)) :
-                  rest;
-              qmax[k] = _mm512_mask_max_pd(qmax[k], in, qmax[k], ratio);
-              rest &= ~in;
-            }
-        }
-      for (unsigned int k = 0; k < n_classes; ++k)
-        q[k] = _mm512_reduce_max_pd(qmax[k]);
-      return count;
+      for (unsigned int d = 0; d < dim; ++d)
+        y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L0 + o), pi[d]);
+      __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+      for (unsigned int d = 1; d < dim; ++d)
+        l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+      return l2;
     }
 #endif
   } // namespace
@@ -331,7 +247,313 @@ namespace PeriDEAL
     for (unsigned int k = 0; k < budget.size(); ++k)
       budget[k].reinit(disc.position, disc.n_owned(), std::max(reach[k], r_min));
     switched_at.assign(disc.n_owned(), -1);
+    setup_lattice_sweep();
     update_row_lists();
+  }
+
+  template <int dim>
+  unsigned int
+  HybridBondBasedModel<dim>::box_index(const unsigned int i, const std::uint64_t b) const
+  {
+    const auto  &li = disc.lattice_index[i];
+    const auto  &lj = disc.lattice_index[disc.neighborhood.col[b]];
+    const int    W  = 2 * box_radius + 1;
+    unsigned int index = 0, stride = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        index += (lj[d] - li[d] + box_radius) * stride;
+        stride *= W;
+      }
+    return index;
+  }
+
+  template <int dim>
+  std::uint64_t
+  HybridBondBasedModel<dim>::find_bond(const unsigned int i, const unsigned int q) const
+  {
+    // Rows list their bonds in increasing box index (the lattice stencil
+    // order); a linear scan if not.
+    const auto   &nb = disc.neighborhood;
+    std::uint64_t lo = nb.row_start[i], hi = nb.row_start[i + 1];
+    while (lo < hi)
+      {
+        const std::uint64_t mid = (lo + hi) / 2;
+        if (box_index(i, mid) < q)
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+    if (lo < nb.row_start[i + 1] && box_index(i, lo) == q)
+      return lo;
+    for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+      if (box_index(i, b) == q)
+        return b;
+    AssertThrow(false, ExcInternalError("A bond of the lattice sweep is missing in its row."));
+    return 0;
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::setup_lattice_sweep()
+  {
+    sweep_on = false;
+#ifdef PERIDEAL_HYBRID_SWEEP
+    // Every rank decides (the shared pattern below is collective).
+    std::int64_t n_box    = 1;
+    const bool   local_ok = [&]() -> bool {
+      const auto        &nb      = disc.neighborhood;
+      const std::size_t  n_local = disc.position.size();
+      const unsigned int n_owned = disc.n_owned();
+      if (dim == 1 || n_owned == 0 || disc.lattice_index.size() != n_local)
+        return false;
+      box_radius = 0;
+      for (unsigned int i = 0; i < n_owned; ++i)
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          for (unsigned int d = 0; d < dim; ++d)
+            box_radius = std::max(box_radius, std::abs(disc.lattice_index[nb.col[b]][d] -
+                                                       disc.lattice_index[i][d]));
+      std::array<int, dim> upper;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          sweep_lower[d] = std::numeric_limits<int>::max();
+          upper[d]       = std::numeric_limits<int>::min();
+        }
+      for (const auto &li : disc.lattice_index)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            sweep_lower[d] = std::min(sweep_lower[d], li[d]);
+            upper[d]       = std::max(upper[d], li[d]);
+          }
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          sweep_stride[d] = n_box;
+          n_box *= upper[d] - sweep_lower[d] + 1;
+        }
+      if (n_box > 8 * std::int64_t(n_local) + 4096 || n_box > (std::int64_t(1) << 30))
+        return false;
+      const int          W   = 2 * box_radius + 1;
+      const unsigned int n_q = std::pow(W, dim);
+      const auto linear = [&](unsigned int q) {
+        std::int64_t o = 0;
+        for (unsigned int d = 0; d < dim; ++d, q /= W)
+          o += std::int64_t(int(q % W) - box_radius) * sweep_stride[d];
+        return o;
+      };
+      // The full offsets that occur, each with one stiffness and length (else
+      // no sweep); the mirror of each too (its bits are cleared on breaking).
+      sweep_of_box.assign(n_q, -1);
+      sweep_offset.clear();
+      sweep_box.clear();
+      sweep_k.clear();
+      sweep_r.clear();
+      const double *coef = op.bond_coefficients().data();
+      const auto    add  = [&](const unsigned int q, const double k, const double r) {
+        sweep_of_box[q] = sweep_offset.size();
+        sweep_offset.push_back(linear(q));
+        sweep_box.push_back(q);
+        sweep_k.push_back(k);
+        sweep_r.push_back(r);
+      };
+      bool table_checked = false;
+      for (unsigned int i = 0; i < n_owned; ++i)
+        {
+          const std::uint64_t begin = nb.row_start[i], n = nb.row_start[i + 1] - begin;
+          const bool          regular = nb.table_start[i] == 0 && n == nb.stencil_size;
+          if (regular && table_checked)
+            continue;
+          for (std::uint64_t e = 0; e < n; ++e)
+            {
+              const unsigned int  q = box_index(i, begin + e);
+              const std::uint64_t t = nb.table_start[i] + e;
+              if (sweep_of_box[q] < 0)
+                add(q, coef[t], nb.bond_length[t]);
+              else if (sweep_k[sweep_of_box[q]] != coef[t] || sweep_r[sweep_of_box[q]] != nb.bond_length[t])
+                return false;
+            }
+          table_checked = table_checked || regular;
+        }
+      for (unsigned int f = 0, n = sweep_offset.size(); f < n; ++f)
+        if (sweep_of_box[n_q - 1 - sweep_box[f]] < 0)
+          add(n_q - 1 - sweep_box[f], sweep_k[f], sweep_r[f]);
+      // A row sums its bonds in the order of the offsets: the box index order
+      // (the same on every rank).
+      {
+        std::vector<unsigned int> order(sweep_offset.size());
+        for (unsigned int f = 0; f < order.size(); ++f)
+          order[f] = f;
+        std::sort(order.begin(), order.end(),
+                  [&](const unsigned int a, const unsigned int b) { return sweep_box[a] < sweep_box[b]; });
+        const auto permute = [&](auto &v) {
+          auto w = v;
+          for (unsigned int f = 0; f < order.size(); ++f)
+            v[f] = w[order[f]];
+        };
+        permute(sweep_offset);
+        permute(sweep_box);
+        permute(sweep_k);
+        permute(sweep_r);
+        for (unsigned int f = 0; f < sweep_box.size(); ++f)
+          sweep_of_box[sweep_box[f]] = f;
+      }
+      const unsigned int n_f = sweep_offset.size();
+      sweep_mirror.resize(n_f);
+      sweep_L2.resize(n_f);
+      sweep_iL2.resize(n_f);
+      sweep_B2.resize(n_f);
+      sweep_class.resize(n_f);
+      for (unsigned int f = 0; f < n_f; ++f)
+        {
+          sweep_mirror[f] = sweep_of_box[n_q - 1 - sweep_box[f]];
+          // The thresholds of the CSR tables (the same expressions of r).
+          const double r = sweep_r[f];
+          sweep_L2[f]    = std::isfinite(s0) ? std::pow(r * (1. + prm.sigma * s0), 2) :
+                                               std::numeric_limits<double>::infinity();
+          sweep_B2[f]    = std::isfinite(s0) ? std::pow(r * (1. + s0), 2) :
+                                               std::numeric_limits<double>::infinity();
+          sweep_iL2[f]   = 1. / sweep_L2[f];
+          unsigned int k = 0;
+          while (k + 1 < class_bound.size() && r > class_bound[k])
+            ++k;
+          sweep_class[f] = k;
+        }
+      return true;
+    }();
+    if (Utilities::MPI::min(int(local_ok), disc.get_mpi_communicator()) == 0)
+      return;
+    setup_shared_pattern();
+
+    std::int64_t reach = 8;
+    for (const auto o : sweep_offset)
+      reach = std::max(reach, std::abs(o));
+    for (const auto o : shared_offset)
+      reach = std::max(reach, std::abs(o));
+    sweep_pad       = 8 * std::size_t((reach + 7) / 8);
+    sweep_n_vectors = (n_box + 7) / 8;
+    sweep_n_alloc   = 2 * sweep_pad + 8 * sweep_n_vectors + 8;
+    const std::size_t n_local = disc.position.size();
+    sweep_position.resize(n_local);
+    sweep_node.assign(8 * sweep_n_vectors, -1);
+    for (std::size_t i = 0; i < n_local; ++i)
+      {
+        std::int64_t L = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          L += std::int64_t(disc.lattice_index[i][d] - sweep_lower[d]) * sweep_stride[d];
+        AssertThrow(sweep_node[L] < 0, ExcInternalError("Two nodes share a lattice position."));
+        sweep_position[i] = L;
+        sweep_node[L]     = i;
+      }
+    sweep_p.assign(dim * sweep_n_alloc, 0.);
+    sweep_u.assign(dim * sweep_n_alloc, 0.);
+    sweep_live_valid = false;
+    sweep_on         = true;
+#endif
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::setup_shared_pattern()
+  {
+    // Rows with the full lattice stencil whose collocation nodes lie at the
+    // same lattice offsets have the same WLS weights up to round-off (the
+    // weights depend on the relative positions only). The pattern is the
+    // most frequent one on the rank with most such rows, its weights those
+    // of the row of lowest global id (the same weights for any partition).
+    const auto        &nb = disc.neighborhood;
+    constexpr unsigned c2 = dim * dim;
+    shared_row.assign(disc.n_owned(), 0);
+    shared_offset.clear();
+    shared_lattice_offset.clear();
+    shared_weight.clear();
+    n_shared_rows = 0;
+    const auto key_of = [&](const unsigned int k) {
+      std::vector<int> key;
+      const unsigned int i = wls->node[k];
+      for (auto e = wls->row_start[k]; e < wls->row_start[k + 1]; ++e)
+        for (unsigned int d = 0; d < dim; ++d)
+          key.push_back(disc.lattice_index[wls->col[e]][d] - disc.lattice_index[i][d]);
+      return key;
+    };
+    const auto regular = [&](const unsigned int i) {
+      return nb.table_start[i] == 0 && nb.row_start[i + 1] - nb.row_start[i] == nb.stencil_size;
+    };
+    std::map<std::vector<int>, unsigned int> count;
+    for (unsigned int k = 0; k < wls->node.size(); ++k)
+      if (regular(wls->node[k]))
+        ++count[key_of(k)];
+    std::vector<int> key;
+    unsigned int     best = 0;
+    for (const auto &[kk, n] : count)
+      if (n > best)
+        {
+          best = n;
+          key  = kk;
+        }
+    const MPI_Comm comm = disc.get_mpi_communicator();
+    const auto     all  = Utilities::MPI::all_gather(comm, best);
+    const unsigned int root = std::max_element(all.begin(), all.end()) - all.begin();
+    if (all[root] == 0)
+      return;
+    key = Utilities::MPI::broadcast(comm, key, root);
+    // The row of lowest id with that key, over all ranks.
+    types::particle_index my_id = std::numeric_limits<types::particle_index>::max();
+    unsigned int          my_row = 0;
+    for (unsigned int k = 0; k < wls->node.size(); ++k)
+      if (regular(wls->node[k]) && disc.id[wls->node[k]] < my_id && key_of(k) == key)
+        {
+          my_id  = disc.id[wls->node[k]];
+          my_row = k;
+        }
+    const auto ids   = Utilities::MPI::all_gather(comm, my_id);
+    const unsigned int owner = std::min_element(ids.begin(), ids.end()) - ids.begin();
+    if (Utilities::MPI::this_mpi_process(comm) == owner)
+      shared_weight.assign(wls->weight.begin() + c2 * wls->row_start[my_row],
+                           wls->weight.begin() + c2 * wls->row_start[my_row + 1]);
+    shared_weight         = Utilities::MPI::broadcast(comm, shared_weight, owner);
+    shared_lattice_offset = key;
+    for (std::size_t c = 0; c < key.size() / dim; ++c)
+      {
+        std::int64_t o = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          o += std::int64_t(key[dim * c + d]) * sweep_stride[d];
+        shared_offset.push_back(o);
+      }
+    // A row uses the shared weights if its own agree to round-off (the WLS
+    // fit of a row is solved to ~1e-13 relative; 1e-9 of the largest
+    // weight leaves margin and still rejects any other pattern).
+    double w_max = 0.;
+    for (const double w : shared_weight)
+      w_max = std::max(w_max, std::abs(w));
+    for (unsigned int k = 0; k < wls->node.size(); ++k)
+      {
+        const unsigned int i = wls->node[k];
+        if (!regular(i) || key_of(k) != key)
+          continue;
+        bool same = true;
+        for (std::size_t e = 0; e < shared_weight.size() && same; ++e)
+          same = std::abs(wls->weight[c2 * wls->row_start[k] + e] - shared_weight[e]) <= 1e-9 * w_max;
+        if (same)
+          {
+            shared_row[i] = 1;
+            ++n_shared_rows;
+          }
+      }
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::build_live_bits()
+  {
+    const auto        &nb = disc.neighborhood;
+    const std::size_t  nv = sweep_n_vectors;
+    sweep_live.assign(sweep_offset.size() * nv, 0);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const std::uint32_t L = sweep_position[i];
+        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+          if (broken_flag[b] == 0)
+            sweep_live[sweep_of_box[box_index(i, b)] * nv + L / 8] |= std::uint8_t(1u << (L % 8));
+      }
+    sweep_live_valid = true;
   }
 
   template <int dim>
@@ -343,10 +565,35 @@ namespace PeriDEAL
       wls_mask[k] = wls_flag.local_element(k) > 0.5;
     standard_rows.clear();
     active_wls_rows.clear();
+    own_weight_rows.clear();
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const bool w = wls_flag.local_element(i) > 0.5;
         (w ? active_wls_rows : standard_rows).push_back(i);
+        if (w && !(sweep_on && shared_row[i]))
+          own_weight_rows.push_back(i);
+      }
+    if (!sweep_on)
+      return;
+    // Lanes per vector of 8 box positions, and the vectors that have any.
+    standard_lanes.assign(sweep_n_vectors, 0);
+    shared_lanes.assign(sweep_n_vectors, 0);
+    wls_lanes.assign(sweep_n_vectors, 0);
+    for (const unsigned int i : active_wls_rows)
+      wls_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
+    for (const unsigned int i : standard_rows)
+      standard_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
+    for (const unsigned int i : active_wls_rows)
+      if (shared_row[i])
+        shared_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
+    standard_vectors.clear();
+    shared_vectors.clear();
+    for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
+      {
+        if (standard_lanes[v])
+          standard_vectors.push_back(v);
+        if (shared_lanes[v])
+          shared_vectors.push_back(v);
       }
   }
 
@@ -369,86 +616,311 @@ namespace PeriDEAL
         seconds[3] += cpu_seconds() - start;
       }
     std::uint64_t n_critical = 0;
-    // Only the Omega_w rows test: every bond with an Omega_w end is tested
-    // in the row of such an end (owned by this or another rank); each of
-    // them tests all its unbroken bonds, so that its record covers them.
-    for (const unsigned int i : active_wls_rows)
+    if (sweep_on)
+      n_critical = sweep_switching_test();
+    else
       {
-        if (prm.switching_bound)
-          {
-            bool needed = false;
-            for (const auto &b : budget)
-              needed = needed || b.needs_check(i);
-            if (!needed)
-              continue;
-          }
-        ++exact_node_tests;
-        const double       *pi    = p + std::size_t(dim) * i;
-        const double       *L2    = critical_length2.data() + nb.table_start[i];
-        const double       *iL2   = inverse_critical_length2.data() + nb.table_start[i];
-        const auto          begin = nb.row_start[i];
-        const unsigned int  n     = nb.row_start[i + 1] - begin;
-        const std::int32_t *col   = nb.col.data() + begin;
-        const std::uint8_t *br    = broken_flag.data() + begin;
-        const double       *r     = nb.bond_length.data() + nb.table_start[i];
-        const unsigned int  n_classes = class_bound.size();
-        double              q[max_classes];
-        unsigned int        count;
-#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
-        if constexpr (dim == 2)
-          count = test_row_avx512(p, pi, col, L2, iL2, r, class_bound.data(), n_classes, br, n, q);
-        else
-#endif
-          count = test_row<dim>(p, pi, col, L2, iL2, r, class_bound.data(), n_classes, br, n, q);
-        for (unsigned int k = 0; k < n_classes; ++k)
-          budget[k].record(i, (1. - std::sqrt(q[k])) * min_threshold[k] - threshold_margin);
-        if (count == 0)
-          continue;
-        n_critical += count;
-        const double *B2 = breaking_length2.data() + nb.table_start[i];
-        for (unsigned int b = 0; b < n; ++b)
-          {
-            const std::int32_t j = col[b];
-            if (br[b])
-              continue;
-            const double l2 = length2<dim>(p + std::size_t(dim) * j, pi);
-            if (l2 >= L2[b])
-              {
-                // Both end points, a ghost one too (sent to its owner below).
-                crit[i] = 1.;
-                crit[j] = 1.;
-                // Once per bond: a bond between two Omega_w nodes is found
-                // from both ends (both bounds fire: each record covers it),
-                // on one rank or two; the end with the lower id counts it.
-                if (l2 > B2[b] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
-                  ++overstretched;
-              }
-          }
+      // Only the Omega_w rows test: every bond with an Omega_w end is tested
+      // in the row of such an end (owned by this or another rank); each of
+      // them tests all its unbroken bonds, so that its record covers them.
+      for (const unsigned int i : active_wls_rows)
+        {
+          if (prm.switching_bound)
+            {
+              bool needed = false;
+              for (const auto &b : budget)
+                needed = needed || b.needs_check(i);
+              if (!needed)
+                continue;
+            }
+          ++exact_node_tests;
+          const double       *pi    = p + std::size_t(dim) * i;
+          const double       *L2    = critical_length2.data() + nb.table_start[i];
+          const double       *iL2   = inverse_critical_length2.data() + nb.table_start[i];
+          const auto          begin = nb.row_start[i];
+          const unsigned int  n     = nb.row_start[i + 1] - begin;
+          const std::int32_t *col   = nb.col.data() + begin;
+          const std::uint8_t *br    = broken_flag.data() + begin;
+          const double       *r     = nb.bond_length.data() + nb.table_start[i];
+          const unsigned int  n_classes = class_bound.size();
+          double              q[max_classes];
+          const unsigned int  count =
+            test_row<dim>(p, pi, col, L2, iL2, r, class_bound.data(), n_classes, br, n, q);
+          for (unsigned int k = 0; k < n_classes; ++k)
+            budget[k].record(i, (1. - std::sqrt(q[k])) * min_threshold[k] - threshold_margin);
+          if (count == 0)
+            continue;
+          n_critical += count;
+          const double *B2 = breaking_length2.data() + nb.table_start[i];
+          for (unsigned int b = 0; b < n; ++b)
+            {
+              const std::int32_t j = col[b];
+              if (br[b])
+                continue;
+              const double l2 = length2<dim>(p + std::size_t(dim) * j, pi);
+              if (l2 >= L2[b])
+                {
+                  // Both end points, a ghost one too (sent to its owner below).
+                  crit[i] = 1.;
+                  crit[j] = 1.;
+                  // Once per bond: a bond between two Omega_w nodes is found
+                  // from both ends (both bounds fire: each record covers it),
+                  // on one rank or two; the end with the lower id counts it.
+                  if (l2 > B2[b] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
+                    ++overstretched;
+                }
+            }
+        }
       }
     // One global sum per step; the ghost exchanges only when needed.
     if (Utilities::MPI::sum(n_critical, disc.get_mpi_communicator()) == 0)
       return false;
     critical.compress(VectorOperation::add); // marks of ghost end points to their owners
     critical.update_ghost_values();
-    bool changed = false;
-    for (const unsigned int i : active_wls_rows)
+    bool       changed = false;
+    const auto switch_node = [&](const unsigned int i) {
+      if (wls_flag.local_element(i) > 0.5)
+        {
+          wls_flag.local_element(i) = 0.;
+          switched_at[i]            = int(n_evaluations) - 1;
+          changed                   = true;
+          // A node never returns to Omega_w: its bound need not grow.
+          for (auto &b : budget)
+            b.record(i, -1.);
+        }
+    };
+    if (sweep_on)
       {
-        bool hit = crit[i] > 0.;
-        for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !hit; ++b)
-          hit = crit[nb.col[b]] > 0.;
-        if (hit)
-          {
-            wls_flag.local_element(i) = 0.;
-            switched_at[i]            = int(n_evaluations) - 1;
-            changed                   = true;
-          }
+        // The families of the (few) critical nodes, owned or ghost, by the
+        // lattice offsets: the family of a node is every node at a stencil
+        // offset (families are symmetric), so i switches iff i or a node
+        // of its family is critical, as below.
+        const std::int64_t n_box = 8 * std::int64_t(sweep_n_vectors);
+        const unsigned int n_owned = disc.n_owned();
+        for (std::size_t c = 0; c < disc.position.size(); ++c)
+          if (crit[c] > 0.)
+            {
+              if (c < n_owned)
+                switch_node(c);
+              for (const std::int64_t o : sweep_offset)
+                {
+                  const std::int64_t L = sweep_position[c] + o;
+                  if (L >= 0 && L < n_box && sweep_node[L] >= 0 &&
+                      sweep_node[L] < std::int32_t(n_owned))
+                    switch_node(sweep_node[L]);
+                }
+            }
       }
+    else
+      for (const unsigned int i : active_wls_rows)
+        {
+          bool hit = crit[i] > 0.;
+          for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1] && !hit; ++b)
+            hit = crit[nb.col[b]] > 0.;
+          if (hit)
+            switch_node(i);
+        }
     critical = 0.;
     critical.zero_out_ghost_values();
     wls_flag.update_ghost_values();
     update_row_lists();
     ++switch_events;
     return changed;
+  }
+
+  template <int dim>
+  std::uint64_t
+  HybridBondBasedModel<dim>::sweep_switching_test()
+  {
+    std::uint64_t n_critical = 0;
+#ifdef PERIDEAL_HYBRID_SWEEP
+    // The Omega_w nodes to test exactly, as lanes of vectors.
+    test_lanes.assign(sweep_n_vectors, 0);
+    for (const unsigned int i : active_wls_rows)
+      {
+        bool needed = !prm.switching_bound;
+        for (const auto &b : budget)
+          needed = needed || b.needs_check(i);
+        if (needed)
+          test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
+      }
+    // A vector costs the same for one lane as for eight: test (and record)
+    // every Omega_w lane of a vector with one to test. An exact test of a
+    // node whose bound has not fired finds nothing critical at it (that is
+    // what the bound proves), so the outcome is unchanged; its record only
+    // restarts its budget.
+    test_vectors.clear();
+    for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
+      if (test_lanes[v])
+        {
+          test_lanes[v] = wls_lanes[v];
+          test_vectors.push_back(v);
+        }
+    const std::size_t   N  = sweep_n_alloc, nv = sweep_n_vectors;
+    const double       *p  = sweep_p.data() + sweep_pad;
+    const unsigned int  n_f = sweep_offset.size(), n_classes = class_bound.size();
+    double             *crit = critical.begin();
+    const std::int32_t *wf   = wls_mask.data();
+    for (const std::uint32_t v : test_vectors)
+      {
+        const __mmask8    lanes = test_lanes[v];
+        const std::size_t L0    = 8 * std::size_t(v);
+        exact_node_tests += __builtin_popcount(lanes);
+        __m512d pi[dim], qmax[max_classes];
+        for (unsigned int d = 0; d < dim; ++d)
+          pi[d] = _mm512_loadu_pd(p + d * N + L0);
+        for (unsigned int k = 0; k < max_classes; ++k)
+          qmax[k] = _mm512_setzero_pd();
+        const std::uint8_t *bits = sweep_live.data() + v;
+        for (unsigned int f = 0; f < n_f; ++f)
+          {
+            const __mmask8 alive = bits[f * nv] & lanes;
+            if (alive == 0)
+              continue;
+            __m512d       y[dim];
+            const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+            const unsigned int k = sweep_class[f];
+            qmax[k] = _mm512_mask_max_pd(qmax[k], alive, qmax[k],
+                                         _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
+            const __mmask8 hit =
+              _mm512_mask_cmp_pd_mask(alive, l2, _mm512_set1_pd(sweep_L2[f]), _CMP_GE_OQ);
+            if (__builtin_expect(hit != 0, 0))
+              {
+                alignas(64) double l2s[8];
+                _mm512_store_pd(l2s, l2);
+                for (unsigned int l = 0; l < 8; ++l)
+                  if ((hit >> l) & 1u)
+                    {
+                      // Both end points, a ghost one too (sent to its owner).
+                      const std::int32_t i = sweep_node[L0 + l],
+                                         j = sweep_node[L0 + l + sweep_offset[f]];
+                      crit[i] = crit[j] = 1.;
+                      ++n_critical;
+                      // Once per bond, as in the row loop below.
+                      if (l2s[l] > sweep_B2[f] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
+                        ++overstretched;
+                    }
+              }
+          }
+        alignas(64) double q[max_classes][8];
+        for (unsigned int k = 0; k < max_classes; ++k)
+          _mm512_store_pd(q[k], qmax[k]);
+        for (unsigned int l = 0; l < 8; ++l)
+          if ((lanes >> l) & 1u)
+            for (unsigned int k = 0; k < n_classes; ++k)
+              budget[k].record(sweep_node[L0 + l],
+                               (1. - std::sqrt(q[k][l])) * min_threshold[k] - threshold_margin);
+      }
+#endif
+    return n_critical;
+  }
+
+  template <int dim>
+  bool
+  HybridBondBasedModel<dim>::sweep_standard_rows(VectorField &force)
+  {
+#ifdef PERIDEAL_HYBRID_SWEEP
+    // Every owned Omega_s node sums the PMB force of all its unbroken bonds
+    // (both copies of a bond between two Omega_s nodes see the same |y|^2
+    // and break together; a bond to Omega_w is evaluated from its Omega_s
+    // end only).
+    const std::size_t  N = sweep_n_alloc, nv = sweep_n_vectors;
+    const double      *p = sweep_p.data() + sweep_pad;
+    const unsigned int n_f = sweep_offset.size();
+    sweep_broken.clear();
+    for (const std::uint32_t v : standard_vectors)
+      {
+        const __mmask8    lanes = standard_lanes[v];
+        const std::size_t L0    = 8 * std::size_t(v);
+        __m512d           pi[dim], acc[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            pi[d]  = _mm512_loadu_pd(p + d * N + L0);
+            acc[d] = _mm512_setzero_pd();
+          }
+        const std::uint8_t *bits = sweep_live.data() + v;
+        for (unsigned int f = 0; f < n_f; ++f)
+          {
+            const __mmask8 alive = bits[f * nv] & lanes;
+            if (alive == 0)
+              continue;
+            __m512d       y[dim];
+            const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+            const __m512d rb = _mm512_set1_pd(sweep_r[f]);
+            __mmask8      brk;
+            const __m512d scale = internal::pmb_bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
+                                             _mm512_mul_pd(_mm512_set1_pd(s0), rb), brk);
+            for (unsigned int d = 0; d < dim; ++d)
+              acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
+            if (__builtin_expect(brk != 0, 0))
+              for (unsigned int l = 0; l < 8; ++l)
+                if ((brk >> l) & 1u)
+                  sweep_broken.emplace_back(f, std::uint32_t(L0 + l));
+          }
+        alignas(64) double out[dim][8];
+        for (unsigned int d = 0; d < dim; ++d)
+          _mm512_store_pd(out[d], acc[d]);
+        for (unsigned int l = 0; l < 8; ++l)
+          if ((lanes >> l) & 1u)
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+      }
+    // Clear both bits of a broken bond and flag its owned CSR copies.
+    for (const auto &[f, L] : sweep_broken)
+      {
+        const std::uint32_t M = L + sweep_offset[f];
+        const unsigned int  g = sweep_mirror[f];
+        sweep_live[f * nv + L / 8] &= std::uint8_t(~(1u << (L % 8)));
+        sweep_live[g * nv + M / 8] &= std::uint8_t(~(1u << (M % 8)));
+        broken_flag[find_bond(sweep_node[L], sweep_box[f])] = 1;
+        if (sweep_node[M] < std::int32_t(disc.n_owned()))
+          broken_flag[find_bond(sweep_node[M], sweep_box[g])] = 1;
+      }
+    return !sweep_broken.empty();
+#else
+    (void)force;
+    return false;
+#endif
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::sweep_wls_rows(VectorField &force)
+  {
+#ifdef PERIDEAL_HYBRID_SWEEP
+    // F = sum_c W_c u(L + o_c) with the shared weights, eight rows at a time.
+    constexpr unsigned int c2 = dim * dim;
+    const std::size_t      N  = sweep_n_alloc;
+    const double          *u  = sweep_u.data() + sweep_pad;
+    const unsigned int     n_c = shared_offset.size();
+    for (const std::uint32_t v : shared_vectors)
+      {
+        const __mmask8    lanes = shared_lanes[v];
+        const std::size_t L0    = 8 * std::size_t(v);
+        __m512d           acc[dim];
+        for (unsigned int a = 0; a < dim; ++a)
+          acc[a] = _mm512_setzero_pd();
+        for (unsigned int c = 0; c < n_c; ++c)
+          {
+            const double *W = shared_weight.data() + c2 * c;
+            for (unsigned int b = 0; b < dim; ++b)
+              {
+                const __m512d ub = _mm512_loadu_pd(u + b * N + L0 + shared_offset[c]);
+                for (unsigned int a = 0; a < dim; ++a)
+                  acc[a] = _mm512_fmadd_pd(_mm512_set1_pd(W[a * dim + b]), ub, acc[a]);
+              }
+          }
+        alignas(64) double out[dim][8];
+        for (unsigned int d = 0; d < dim; ++d)
+          _mm512_store_pd(out[d], acc[d]);
+        for (unsigned int l = 0; l < 8; ++l)
+          if ((lanes >> l) & 1u)
+            for (unsigned int d = 0; d < dim; ++d)
+              force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+      }
+#else
+    (void)force;
+#endif
   }
 
   template <int dim>
@@ -465,12 +937,31 @@ namespace PeriDEAL
     for (unsigned int d = 0; d < dim; ++d)
       mid[d] = int(disc.lattice_size()[d] / 2);
     const Point<dim> xc = disc.lattice_point(mid);
-    for (unsigned int d = 0; d < dim; ++d)
+    if (sweep_on)
       {
-        const double *ud = u[d].begin();
-        for (std::size_t i = 0; i < n_local; ++i)
-          deformed[dim * i + d] = (x[i][d] - xc[d]) + ud[i];
+        // p and u over the box (the same p as the row loops).
+        if (!sweep_live_valid)
+          build_live_bits();
+        const std::size_t N = sweep_n_alloc;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double *ud = u[d].begin();
+            double       *pd = sweep_p.data() + sweep_pad + d * N;
+            double       *vd = sweep_u.data() + sweep_pad + d * N;
+            for (std::size_t i = 0; i < n_local; ++i)
+              {
+                pd[sweep_position[i]] = (x[i][d] - xc[d]) + ud[i];
+                vd[sweep_position[i]] = ud[i];
+              }
+          }
       }
+    else
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double *ud = u[d].begin();
+          for (std::size_t i = 0; i < n_local; ++i)
+            deformed[dim * i + d] = (x[i][d] - xc[d]) + ud[i];
+        }
     // Without a finite s0 nothing is ever critical (and s0 is the same on
     // every rank).
     if ((n_evaluations++ % prm.check_interval == 0) && std::isfinite(s0) &&
@@ -480,13 +971,20 @@ namespace PeriDEAL
 
     // Omega_s: the nonlinear PMB force (3.1) with breaking (2.34), as in
     // BondBasedOperator: force k (l - r) y / l, break when l - r > s0 r.
-    start               = cpu_seconds();
+    start = cpu_seconds();
+    if (sweep_on)
+      {
+        op_stale = sweep_standard_rows(force) || op_stale;
+        seconds[1] += (cpu_seconds() - start);
+        start = cpu_seconds();
+        sweep_wls_rows(force);
+      }
     const auto   &nb    = disc.neighborhood;
     auto         &flags = broken_flag;
     bool          broke = false;
     const double *p     = deformed.data();
     const double *coef  = op.bond_coefficients().data();
-    for (const unsigned int i : standard_rows)
+    for (const unsigned int i : sweep_on ? std::vector<unsigned int>() : standard_rows)
       {
         const double       *pi = p + std::size_t(dim) * i;
         const double       *k  = coef + nb.table_start[i];
@@ -496,22 +994,20 @@ namespace PeriDEAL
         const std::int32_t *col   = nb.col.data() + begin;
         std::uint8_t       *br    = flags.data() + begin;
         double             f[dim] = {};
-        unsigned int       n_break;
-#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
-        if constexpr (dim == 2)
-          n_break = pmb_row_avx512(p, pi, col, k, r, br, n, s0, f);
-        else
-#endif
-          n_break = pmb_row<dim>(p, pi, col, k, r, br, n, s0, f);
+        const unsigned int n_break = pmb_row<dim>(p, pi, col, k, r, br, n, s0, f);
         broke = broke || n_break > 0;
         for (unsigned int d = 0; d < dim; ++d)
           force[d].local_element(i) = f[d];
       }
     op_stale = op_stale || broke;
-    seconds[1] += (cpu_seconds() - start);
+    if (!sweep_on)
+      {
+        seconds[1] += (cpu_seconds() - start);
+        start = cpu_seconds();
+      }
 
-    // Omega_w: F_i = sum_c W_ic u_c, dim x dim blocks (row-major).
-    start = cpu_seconds();
+    // Omega_w rows with their own weights: F_i = sum_c W_ic u_c, dim x dim
+    // blocks (row-major).
     std::array<const double *, dim> ud;
     for (unsigned int d = 0; d < dim; ++d)
       ud[d] = u[d].begin();
@@ -520,7 +1016,7 @@ namespace PeriDEAL
     if constexpr (dim == 2)
       {
         // Packed rows: 8 collocation nodes per chunk, two gathers, four FMAs.
-        for (const unsigned int i : active_wls_rows)
+        for (const unsigned int i : own_weight_rows)
           {
             const unsigned int k  = wls_row[i];
             __m512d            a0 = _mm512_setzero_pd(), a1 = _mm512_setzero_pd();
@@ -543,7 +1039,7 @@ namespace PeriDEAL
         return;
       }
 #endif
-    for (const unsigned int i : active_wls_rows)
+    for (const unsigned int i : own_weight_rows)
       {
         const unsigned int k = wls_row[i];
         double             f[dim] = {};

@@ -135,6 +135,112 @@ namespace
   }
 
   // Damage of the owned nodes keyed by node id.
+  // (d) The lattice sweeps against the row loops: on the patch of (a)
+  // (s0 = infinity, no breaking) with a smooth random-phase displacement,
+  // (i) the shared weights of the interior collocation pattern equal each
+  // row's own WLS weights (from its own fit) to round-off, (ii) the forces
+  // of the shared-pattern WLS rows equal sum_c W_ic u_c over the row's own
+  // CSR weights, (iii) the forces of the Omega_s rows equal the
+  // BondBasedOperator's (its own loops) up to summation-order round-off.
+  void
+  sweep()
+  {
+    LatticeParameters lp;
+    lp.dx            = 1.;
+    lp.delta         = 4.;
+    lp.cell_centered = true;
+    const double      L = 40.;
+    Discretization<2> disc(MPI_COMM_WORLD);
+    disc.setup(BoxDomain<2>(Point<2>(0., 0.), Point<2>(L, L)), lp);
+    BondBasedModelParameters mp;
+    BondBasedOperator<2>     op(disc, mp);
+    std::vector<bool>        standard(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const auto &x = disc.position[i];
+        standard[i]   = x[0] < L / 2 || std::min(std::min(x[0], L - x[0]), std::min(x[1], L - x[1])) <
+                                        lp.delta;
+      }
+    HybridBondBasedModel<2> model(op, InfluenceFunction::constant, HybridMechanicsParameters(),
+                                  standard);
+    if (!model.uses_lattice_sweep())
+      {
+        if (root())
+          std::cout << "  lattice sweep not compiled (no AVX-512): nothing to compare" << std::endl;
+        return;
+      }
+    const auto &wls = model.wls_quadrature();
+    const auto &W   = model.shared_pattern_weights();
+    double      w_max = 0.;
+    for (const double w : W)
+      w_max = std::max(w_max, std::abs(w));
+    unsigned int n_shared = 0, size_differs = 0;
+    double       weight_diff = 0.;
+    for (unsigned int k = 0; k < wls.node.size(); ++k)
+      if (model.uses_shared_pattern(wls.node[k]))
+        {
+          ++n_shared;
+          const auto begin = 4 * wls.row_start[k];
+          size_differs += 4 * wls.row_start[k + 1] - begin != W.size();
+          for (std::size_t e = 0; e < W.size() && e < 4 * wls.row_start[k + 1] - begin; ++e)
+            weight_diff = std::max(weight_diff, std::abs(wls.weight[begin + e] - W[e]));
+        }
+    n_shared    = Utilities::MPI::sum(n_shared, MPI_COMM_WORLD);
+    weight_diff = Utilities::MPI::max(weight_diff, MPI_COMM_WORLD) / w_max;
+    size_differs = Utilities::MPI::sum(size_differs, MPI_COMM_WORLD);
+    check(n_shared > 100 && W.size() == 4 * 29 && size_differs == 0,
+          std::to_string(n_shared) + " WLS rows share the interior pattern of 29 nodes");
+    check(weight_diff <= 1e-12,
+          "shared vs own WLS weights: max |W_shared - W_i| / max |W| = " + sci(weight_diff) +
+            " <= 1e-12 (round-off of the per-node fits)");
+
+    MechanicsModel<2>::VectorField u, f, g;
+    model.initialize(u);
+    model.initialize(f);
+    model.initialize(g);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const auto &x = disc.position[i];
+        u[0].local_element(i) = 1e-3 * std::sin(0.3 * x[0] + 0.7 * x[1] + 0.1);
+        u[1].local_element(i) = 1e-3 * std::cos(0.5 * x[0] - 0.2 * x[1]);
+      }
+    for (auto &v : u)
+      v.update_ghost_values();
+    model.compute_forces(u, f);
+    op.compute_forces(u, g);
+    double wls_diff = 0., std_diff = 0., f_max = 0.;
+    for (unsigned int k = 0; k < wls.node.size(); ++k)
+      {
+        const unsigned int i = wls.node[k];
+        double             F[2] = {0., 0.};
+        for (auto e = wls.row_start[k]; e < wls.row_start[k + 1]; ++e)
+          for (unsigned int a = 0; a < 2; ++a)
+            for (unsigned int b = 0; b < 2; ++b)
+              F[a] += wls.weight[4 * e + 2 * a + b] * u[b].local_element(wls.col[e]);
+        for (unsigned int a = 0; a < 2; ++a)
+          {
+            wls_diff = std::max(wls_diff, std::abs(F[a] - f[a].local_element(i)));
+            f_max    = std::max(f_max, std::abs(F[a]));
+          }
+      }
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      if (model.scheme().local_element(i) < 0.5)
+        for (unsigned int a = 0; a < 2; ++a)
+          {
+            std_diff = std::max(std_diff, std::abs(f[a].local_element(i) - g[a].local_element(i)));
+            f_max    = std::max(f_max, std::abs(g[a].local_element(i)));
+          }
+    f_max    = Utilities::MPI::max(f_max, MPI_COMM_WORLD);
+    wls_diff = Utilities::MPI::max(wls_diff, MPI_COMM_WORLD) / f_max;
+    std_diff = Utilities::MPI::max(std_diff, MPI_COMM_WORLD) / f_max;
+    // Sums of ~30 (WLS) and ~50 (PMB) terms of size up to the forces'
+    // scale in another order, and 1/l by rsqrt and Newton steps: 1e-12.
+    check(wls_diff <= 1e-12, "WLS sweep rows vs own-weight rows: max |dF| / max |F| = " +
+                               sci(wls_diff) + " <= 1e-12");
+    check(std_diff <= 1e-12, "standard sweep rows vs BondBasedOperator: max |dF| / max |F| = " +
+                               sci(std_diff) + " <= 1e-12");
+  }
+
   std::map<types::particle_index, double>
   damage_by_id(const MechanicsSolver<2> &s)
   {
@@ -397,5 +503,6 @@ main(int argc, char **argv)
               {"kw", kw},
               {"rank_invariance", rank_invariance},
               {"bad_input", bad_input},
+              {"sweep", sweep},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

@@ -2,8 +2,10 @@
 # fracture: patch test, Kalthoff-Winkler at CI size against the standard
 # scheme, rank invariance, bad input (one executable).
 perideal_add_test_program(hybrid_kw_tests ${CMAKE_CURRENT_LIST_DIR}/hybrid_kw_tests.cc)
-foreach(_t patch kw bad_input stretch_budget)
+foreach(_t patch kw bad_input stretch_budget sweep)
   perideal_add_test(NAME hybrid_kw.${_t} COMMAND $<TARGET_FILE:hybrid_kw_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME hybrid_kw.rank_invariance.np2 NPROCS 2
   COMMAND $<TARGET_FILE:hybrid_kw_tests> rank_invariance LABELS "unit;mpi")
+perideal_add_test(NAME hybrid_kw.sweep.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:hybrid_kw_tests> sweep LABELS "unit;mpi")

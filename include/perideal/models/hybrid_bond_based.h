@@ -6,6 +6,7 @@
 #include <perideal/models/stretch_budget.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -95,6 +96,18 @@ namespace PeriDEAL
    * critical, and only then are the critical flags and the new schemes sent
    * to the ghosts.
    *
+   * Lattice sweeps (AVX-512, dim > 1, uniform bonds per lattice offset,
+   * uses_lattice_sweep()): p = x - x_c + u and u are laid out over the box
+   * of lattice positions and every row runs over the (signed) stencil
+   * offsets, eight consecutive positions at a time, with per-offset bits
+   * for the unbroken bonds: the Omega_s rows (PMB force and breaking, the
+   * arithmetic of BondBasedOperator's AVX-512 loops), the exact switching
+   * test (every Omega_w lane of a vector with a lane whose bound fired) and
+   * the WLS rows of the interior collocation pattern, which share one set
+   * of weights (those of the row of lowest id; rows whose own weights
+   * differ, near boundaries, keep them). A row sums its bonds in a fixed
+   * offset order, so that results do not depend on the partition.
+   *
    * The WLS rows of all initial Omega_w nodes are computed once at
    * construction; a switched node just stops using its row. Damage,
    * strain energy (bond energies (2.26) for every node, a diagnostic) and
@@ -165,6 +178,7 @@ namespace PeriDEAL
       op_stale    = false;
       for (auto &b : budget) // bonds may have been restored
         b.invalidate();
+      sweep_live_valid = false;
     }
     std::uint64_t
     n_broken_bonds() const override
@@ -177,7 +191,8 @@ namespace PeriDEAL
     {
       sync_broken_flags();
       op.add_precrack(polygon);
-      broken_flag = op.broken();
+      broken_flag      = op.broken();
+      sweep_live_valid = false;
     }
     /**
      * min of the standard bound (3.8) over all rows (any node may switch)
@@ -236,6 +251,46 @@ namespace PeriDEAL
     {
       return exact_node_tests;
     }
+    /**
+     * True if the rows run as lattice sweeps (AVX-512, dim > 1, lattice
+     * indices of all local nodes, bond stiffness and length uniform per
+     * lattice offset); else the portable row loops over the CSR lists.
+     */
+    bool
+    uses_lattice_sweep() const
+    {
+      return sweep_on;
+    }
+    /**
+     * Number of owned Omega_w rows that use the shared WLS weights of the
+     * interior collocation pattern (lattice sweep only; the others keep
+     * their own row of weights).
+     */
+    unsigned int
+    n_shared_pattern_rows() const
+    {
+      return n_shared_rows;
+    }
+    /**
+     * The shared WLS pattern: lattice offsets (dim per collocation node) and
+     * dim x dim weights per collocation node (empty if none is used).
+     */
+    const std::vector<int> &
+    shared_pattern_offsets() const
+    {
+      return shared_lattice_offset;
+    }
+    const std::vector<double> &
+    shared_pattern_weights() const
+    {
+      return shared_weight;
+    }
+    /** Per owned node: true if its WLS row uses the shared pattern weights. */
+    bool
+    uses_shared_pattern(const unsigned int i) const
+    {
+      return !shared_row.empty() && shared_row[i];
+    }
     /** The WLS quadrature of the initial Omega_w rows. */
     const WlsQuadrature<dim> &
     wls_quadrature() const
@@ -268,6 +323,28 @@ namespace PeriDEAL
     /** Rebuild the row lists after a change of scheme. */
     void
     update_row_lists();
+    /** Set up the lattice sweep (sweep_on) if the lattice allows it. */
+    void
+    setup_lattice_sweep();
+    /** Find the rows of Omega_w that share the interior WLS pattern. */
+    void
+    setup_shared_pattern();
+    /** The live bits of the sweep from broken_flag. */
+    void
+    build_live_bits();
+    /** Index of the bond of owned row @p i with lattice box index @p q (CSR). */
+    std::uint64_t
+    find_bond(const unsigned int i, const unsigned int q) const;
+    /** Lattice box index of bond @p b of row @p i (offset + box_radius per dimension). */
+    unsigned int
+    box_index(const unsigned int i, const std::uint64_t b) const;
+    /** The sweep versions of the switching test and of the rows. */
+    std::uint64_t
+    sweep_switching_test();
+    bool
+    sweep_standard_rows(VectorField &force);
+    void
+    sweep_wls_rows(VectorField &force);
 
     BondBasedOperator<dim>    &op;
     const Discretization<dim> &disc;
@@ -290,6 +367,8 @@ namespace PeriDEAL
     std::vector<std::int32_t> wls_mask;
     /** Owned Omega_s rows; owned Omega_w rows. */
     std::vector<unsigned int> standard_rows, active_wls_rows;
+    /** Owned Omega_w rows with their own weights (all of them without the sweep). */
+    std::vector<unsigned int> own_weight_rows;
     /** Per bond table entry: (r (1 + sigma s0))^2, (r (1 + s0))^2, 1 / (r (1 + sigma s0))^2. */
     std::vector<double> critical_length2, breaking_length2, inverse_critical_length2;
     /**
@@ -310,6 +389,47 @@ namespace PeriDEAL
     /** Scratch: deformed positions x - x_c + u, interleaved. */
     std::vector<double> deformed;
     std::uint64_t       overstretched = 0;
+
+    /**
+     * @name The lattice sweep: box positions L = sum_d (l_d - lower_d)
+     * stride_d of the local nodes, every array over the box padded by pad
+     * positions in front and behind (offsets up to +-pad never leave it),
+     * vectors of 8 consecutive positions. Full (signed) bond offsets: a
+     * row sums over all of them in a fixed order, so that the force of a
+     * node does not depend on the box, i.e. on the partition.
+     */
+    /** @{ */
+    bool                              sweep_on   = false;
+    int                               box_radius = 0;
+    std::array<int, dim>              sweep_lower{};
+    std::array<std::int64_t, dim>     sweep_stride{};
+    std::size_t                       sweep_pad = 0, sweep_n_vectors = 0, sweep_n_alloc = 0;
+    /** Per full offset f: linear offset, mirror offset, box index, k, r, thresholds, class. */
+    std::vector<std::int64_t>  sweep_offset;
+    std::vector<unsigned int>  sweep_mirror, sweep_box;
+    std::vector<int>           sweep_of_box;
+    std::vector<double>        sweep_k, sweep_r, sweep_L2, sweep_iL2, sweep_B2;
+    std::vector<std::uint8_t>  sweep_class;
+    /** Box position of each local node; node (or -1) of each box position. */
+    std::vector<std::uint32_t> sweep_position;
+    std::vector<std::int32_t>  sweep_node;
+    /** Bit (f, L): bond (L, L + o_f) of an owned row exists and is unbroken. */
+    std::vector<std::uint8_t>  sweep_live;
+    bool                       sweep_live_valid = false;
+    /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
+    std::vector<double> sweep_p, sweep_u;
+    /** Per vector: lanes of owned Omega_s nodes, of shared-pattern WLS rows, to be tested. */
+    std::vector<std::uint8_t>  standard_lanes, shared_lanes, wls_lanes, test_lanes;
+    std::vector<std::uint32_t> standard_vectors, shared_vectors, test_vectors;
+    /** Bonds broken by the sweep: (full offset, box position of the row). */
+    std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
+    /** The shared WLS pattern: linear and lattice offsets, weights; per owned node: uses it. */
+    std::vector<std::int64_t> shared_offset;
+    std::vector<int>          shared_lattice_offset;
+    std::vector<double>       shared_weight;
+    std::vector<std::uint8_t> shared_row;
+    unsigned int              n_shared_rows = 0;
+    /** @} */
     unsigned int        n_evaluations = 0;
     unsigned int        switch_events = 0;
   };
