@@ -645,6 +645,11 @@ namespace PeriDEAL
       disc.update_fictitious(C);
       update_phase();
       implicit->valid = false;
+      // the solid counts of the phase classification (setup, not stepping)
+      if (prm.corrosion)
+        solid_count.initialize(disc.n_active(), disc.row_start.data(), disc.col.data(),
+                               disc.n_nodes(),
+                               [&](const unsigned int j) { return phase[j] > 0.5; });
     }
 
     template <int dim>
