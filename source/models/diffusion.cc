@@ -39,6 +39,31 @@ namespace PeriDEAL
       return (s0 + s1) + (s2 + s3);
     }
 
+    // sum_k w_k kappa (c[ci[k]] - c_i) of a one-kappa row: four independent
+    // chains as above (the summation order differs from the per-bond loop
+    // only at round-off; the differences keep the cancellation-free form).
+    PERIDEAL_SCALAR_LOOP inline double
+    difference_row_sum(const std::int32_t *ci,
+                       const double       *wi,
+                       const unsigned int  m,
+                       const double       *c,
+                       const double        c_i,
+                       const double        kappa)
+    {
+      double       s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
+      unsigned int k  = 0;
+      for (; k + 4 <= m; k += 4)
+        {
+          s0 += wi[k] * kappa * (c[ci[k]] - c_i);
+          s1 += wi[k + 1] * kappa * (c[ci[k + 1]] - c_i);
+          s2 += wi[k + 2] * kappa * (c[ci[k + 2]] - c_i);
+          s3 += wi[k + 3] * kappa * (c[ci[k + 3]] - c_i);
+        }
+      for (; k < m; ++k)
+        s0 += wi[k] * kappa * (c[ci[k]] - c_i);
+      return (s0 + s1) + (s2 + s3);
+    }
+
     // Long rows (3D, large m): the vectorized gather loop wins.
     inline double
     weighted_row_sum_long(const std::int32_t *ci,
@@ -267,24 +292,53 @@ namespace PeriDEAL
         }
       return s;
     };
-    for_standard_rows([&](const unsigned int i) { r[i] = standard_row(i); });
+    // Rows whose neighbours are all of one phase: one kappa on every bond,
+    // the same products as standard_row() without the phase look-ups, in
+    // four chains (equal up to round-off). kappa = 0 (solid interior): every
+    // term of standard_row() is a signed zero and its sum +0, so the row is
+    // exactly 0 without summing.
+    const unsigned int n_local = n + disc.n_ghost();
+    if (classify)
+      {
+        auto solid = [&](const unsigned int j) { return ph[j] > 0.5; };
+        if (!solid_count.initialized())
+          solid_count.initialize(n, row_start, col, n_local, solid);
+        else
+          solid_count.update(solid);
+      }
+    auto row_value = [&](const unsigned int i) {
+      const int uniform = classify ? solid_count.uniform_phase(i) : -1;
+      if (uniform < 0)
+        return standard_row(i);
+      const double kappa = bond_kappa(ph[i] > 0.5, uniform == 1);
+      if (kappa == 0.)
+        return 0.;
+      return difference_row_sum(col + row_start[i], gw + table[i],
+                                row_start[i + 1] - row_start[i], c, c[i], kappa);
+    };
+    for_standard_rows([&](const unsigned int i) { r[i] = row_value(i); });
     if (wls)
       // Omega_w: a WLS row is one phase's operator, valid while all its
       // collocation nodes share the phase of x_i (kappa of that phase's
       // bonds, the weights carry no kappa); once the interface reaches them
-      // the row falls back to the standard scheme.
+      // the row falls back to the standard scheme. The collocation nodes
+      // are family nodes (or x_i): a family of x_i's phase needs no check.
       for (unsigned int k = 0; k < wls->node.size(); ++k)
         {
           const unsigned int i     = wls->node[k];
           const bool         solid = ph[i] > 0.5;
           const auto         b = wls->row_start[k], e = wls->row_start[k + 1];
-          bool               same = true;
-          for (auto t = b; t < e && same; ++t)
-            same = (ph[wls->col[t]] > 0.5) == solid;
+          bool same = classify && solid_count.uniform_phase(i) == int(solid);
+          if (!same)
+            {
+              same = true;
+              for (auto t = b; t < e && same; ++t)
+                same = (ph[wls->col[t]] > 0.5) == solid;
+            }
           r[i] = same ? bond_kappa(solid, solid) *
                           weighted_row_sum_short(wls->col.data() + b, wls->weight.data() + b,
                                                  e - b, c) :
-                        standard_row(i);
+                        row_value(i);
         }
   }
 

@@ -895,6 +895,131 @@ end
       }
   }
 
+
+  // The phase classification of the corrosion operators (one-phase rows
+  // summed with one kappa in four chains, kappa-0 rows skipped, WLS rows with
+  // a one-phase family not re-checked) against the per-bond kernel, along
+  // corroding trajectories with phase flips every few steps (the solid
+  // counts are updated incrementally): (a) the uniform hybrid operator of
+  // the reduced Sect. 3.3.2 ball case, (b) the adaptive hybrid multi-grid
+  // of the reduced [100] Example 2. Rates must agree to round-off: the
+  // chains reorder sums of at most ~1000 terms, whose rounding error is
+  // below 1e-13 of the largest term; we allow 1e-12 of max |rate| (the
+  // largest terms sit at the interface, where the rates are largest).
+  // Rows that the classification sets to 0 (kappa 0) must be exactly 0.
+  void
+  phase_classification()
+  {
+    {
+      // C_sat raised from 5100 to 100000 so that surface nodes dissolve
+      // within the 60 steps (phase flips exercise the incremental counts);
+      // r_s > delta: solid interior rows with kappa 0 exist
+      std::string text = corrosion_3d_hybrid_parameters(
+        1.2, 0.75, 6., 360., corrosion_3d_hybrid_region(0.75, 0.3));
+      const std::string c_sat = "Saturation concentration = 5100";
+      text.replace(text.find(c_sat), c_sat.size(), "Saturation concentration = 100000");
+      const auto         prm = parameters_from_text<DiffusionRunParameters<3>>(text);
+      DiffusionSolver<3> solver(MPI_COMM_WORLD, prm);
+      solver.setup();
+      const auto &disc = solver.discretization();
+      DiffusionOperator<3> fast(disc, prm.model), reference(disc, prm.model);
+      reference.set_phase_classification(false);
+      const auto &rows = solver.get_operator().wls_quadrature()->node;
+      fast.set_wls_rows(prm.wls, rows);
+      reference.set_wls_rows(prm.wls, rows);
+      PeriDEAL::Vector a, b;
+      disc.initialize_vector(a);
+      disc.initialize_vector(b);
+      double       worst = 0., v0 = solver.diagnostics().solid_volume;
+      unsigned int zeros = 0, flips = 0;
+      double       last_v = v0;
+      while (solver.step() < solver.n_steps())
+        {
+          solver.advance();
+          const double v = solver.diagnostics().solid_volume;
+          flips += v != last_v;
+          last_v = v;
+          fast.apply(solver.solution(), a, &solver.phase_field(),
+                     DiffusionOperator<3>::Rows::interior);
+          reference.apply(solver.solution(), b, &solver.phase_field(),
+                          DiffusionOperator<3>::Rows::interior);
+          double diff = 0., scale = 0.;
+          for (unsigned int i = 0; i < disc.n_owned(); ++i)
+            if (disc.region[i] == PeriDEAL::Discretization<3>::interior)
+              {
+                diff  = std::max(diff, std::abs(a.local_element(i) - b.local_element(i)));
+                scale = std::max(scale, std::abs(b.local_element(i)));
+                if (a.local_element(i) == 0. && solver.phase_field().local_element(i) > 0.5)
+                  {
+                    ++zeros;
+                    check(b.local_element(i) == 0., "skipped solid row is exactly 0");
+                  }
+              }
+          worst = std::max(worst, diff / scale);
+        }
+      std::cout << "  uniform hybrid: " << solver.n_steps() << " steps, " << flips
+                << " steps with phase flips, loss " << 1. - last_v / v0
+                << ", zero solid rows (cumulative) " << zeros << ", max |diff| / max |rate| "
+                << worst << std::endl;
+      check(flips > 5, "phases flip during the run");
+      check(zeros > 0, "solid interior rows are skipped");
+      check(worst < 1e-12, "classified = per-bond rates to round-off: " + sci(worst));
+    }
+    {
+      MultiGrid::Parameters<3> p;
+      const double             h = 0.075, H = 0.15, L = 1.05;
+      p.delta     = 0.45;
+      p.exponent  = 1.;
+      p.coarse_dx = H;
+      p.fine_dx   = h;
+      for (unsigned int d = 0; d < 3; ++d)
+        {
+          p.lower[d] = -L;
+          p.upper[d] = L;
+        }
+      p.fine_region = MultiGrid::Region<3>::cylinder(Point<3>(), 0.45, 0.6);
+      const MultiGrid::Discretization<3> disc(p);
+      MultiGrid::CylinderCorrosionCase   c;
+      MultiGrid::TransportParameters     t = c.transport;
+      t.coarse_quadrature                  = "wls";
+      MultiGrid::TransportSolver<3> solver(disc, t);
+      solver.set_initial([](const Point<3> &x) {
+        return x[0] * x[0] + x[1] * x[1] < 0.09 && std::abs(x[2]) < 0.3 ? 1. : 0.;
+      });
+      solver.set_constrained([&](const Point<3> &x) {
+        return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])}) > L + H / 2. - p.delta;
+      });
+      std::vector<double> a, b;
+      double              worst = 0., v0 = solver.solid_volume();
+      unsigned int        used_fast = 0, used_reference = 0;
+      for (unsigned int k = 0; k < 15; ++k)
+        {
+          solver.advance();
+          solver.set_phase_classification(true);
+          solver.apply(solver.solution(), a);
+          used_fast += solver.n_wls_rows_used();
+          solver.set_phase_classification(false);
+          solver.apply(solver.solution(), b);
+          used_reference += solver.n_wls_rows_used();
+          double diff = 0., scale = 0.;
+          for (std::size_t i = 0; i < a.size(); ++i)
+            {
+              diff  = std::max(diff, std::abs(a[i] - b[i]));
+              scale = std::max(scale, std::abs(b[i]));
+              if (a[i] == 0. && solver.phase_field()[i] > 0.5)
+                check(b[i] == 0., "skipped solid row is exactly 0");
+            }
+          worst = std::max(worst, diff / scale);
+        }
+      std::cout << "  adaptive hybrid multi-grid: loss " << 1. - solver.solid_volume() / v0
+                << ", WLS rows used " << used_fast << " / " << used_reference
+                << ", max |diff| / max |rate| " << worst << std::endl;
+      check(solver.solid_volume() < 0.9 * v0, "the solid corrodes");
+      check(used_fast == used_reference && used_fast > 0, "the same WLS rows are used");
+      check(worst < 1e-12, "classified = per-bond rates to round-off: " + sci(worst));
+    }
+  }
+
   // The 3D hybrid corrosion run on all ranks against each rank alone: the
   // relative volume-loss histories must be identical (same WLS weights and
   // the same per-row summation; only the global sums differ by round-off).
@@ -945,5 +1070,6 @@ main(int argc, char **argv)
               {"hybrid_corrosion_3d", hybrid_corrosion_3d},
               {"corrosion_3d", corrosion_3d},
               {"coarse_wls_exactness", coarse_wls_exactness},
-              {"hybrid_corrosion_3d_ranks", hybrid_corrosion_3d_ranks}});
+              {"hybrid_corrosion_3d_ranks", hybrid_corrosion_3d_ranks},
+              {"phase_classification", phase_classification}});
 }

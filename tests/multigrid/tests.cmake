@@ -20,3 +20,6 @@ perideal_add_test(NAME multigrid.corrosion_3d
   COMMAND $<TARGET_FILE:multigrid_tests> corrosion_3d LABELS unit)
 perideal_add_test(NAME multigrid.hybrid_corrosion_3d.np2 NPROCS 2
   COMMAND $<TARGET_FILE:multigrid_tests> hybrid_corrosion_3d_ranks LABELS "unit;mpi")
+# Phase classification of the corrosion operators vs the per-bond kernel
+perideal_add_test(NAME multigrid.phase_classification
+  COMMAND $<TARGET_FILE:multigrid_tests> phase_classification LABELS unit)

@@ -8,6 +8,7 @@
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/wls_quadrature.h>
+#include <perideal/models/solid_neighbor_count.h>
 
 #include <algorithm>
 #include <array>
@@ -236,6 +237,23 @@ namespace PeriDEAL
     bool
     gershgorin_proves_stability() const;
 
+    /**
+     * Corrosion: classify the rows by the phases of their neighbours
+     * (default true). A row whose neighbours all have one phase has one
+     * micro-diffusivity on every bond and is summed without looking up the
+     * neighbours' phases (the same value up to round-off, four summation chains;
+     * exactly 0 without summing if
+     * that kappa is 0, e.g. the solid interior); a WLS row whose family is
+     * of one phase skips the per-step check of its collocation nodes. The
+     * per-row counts of solid neighbours are updated incrementally when
+     * phases flip. false: the per-bond kernel on every row (reference).
+     */
+    void
+    set_phase_classification(const bool on)
+    {
+      classify = on;
+    }
+
     /** The bond coefficient kappa for end-point phases (0 liquid, 1 solid). */
     double
     bond_kappa(const bool solid_i, const bool solid_j) const
@@ -257,6 +275,9 @@ namespace PeriDEAL
     std::vector<unsigned char>          is_wls;
     /** Owned interior rows that use the standard scheme (Rows::interior). */
     std::vector<unsigned int> interior_standard_rows;
+    /** Corrosion: solid neighbours per owned row (set_phase_classification()). */
+    bool                       classify = true;
+    mutable SolidNeighborCount solid_count;
 
     /** |l_ii| + R_i and l_ii <= 0 && R_i <= |l_ii| of WLS row k. */
     std::pair<double, bool>

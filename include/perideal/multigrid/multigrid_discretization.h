@@ -5,6 +5,7 @@
 
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/wls_quadrature.h>
+#include <perideal/models/solid_neighbor_count.h>
 
 #include <algorithm>
 #include <array>
@@ -324,6 +325,20 @@ namespace PeriDEAL
         return n_wls_used;
       }
 
+      /**
+       * Corrosion: rows whose neighbours (active and fictitious) are all of
+       * one phase are summed with that one kappa, without per-bond phase
+       * look-ups (the same values up to round-off: four summation chains), rows with kappa 0 skipped (exactly 0), and
+       * WLS rows with an all-liquid family skip the per-step phase check of
+       * their collocation nodes (default true; false: the per-bond kernel on
+       * every row, for reference).
+       */
+      void
+      set_phase_classification(const bool on)
+      {
+        classify = on;
+      }
+
       /** One time step. */
       void
       advance();
@@ -407,6 +422,8 @@ namespace PeriDEAL
       std::unique_ptr<WlsQuadrature<dim>> wls; ///< coarse WLS rows
       std::vector<int>          wls_row;       ///< per active node: row of wls or -1
       mutable unsigned int      n_wls_used = 0;
+      bool                       classify = true;
+      mutable SolidNeighborCount solid_count; ///< solid neighbours per active row
     };
 
     /**
