@@ -611,8 +611,9 @@ namespace
     mp.time_step  = 1e-4;
     // Nothing reflected at L_ref is back in (-L, L) before T (speed <= chi,
     // pulse half-width ~1): 2 L_ref - L - 1 > chi T, 1 unit margin (full:
-    // 29.2 instead of the source's 60, same property).
-    const double L_ref = 0.5 * (chi * T + L + 1.) + 1.;
+    // 29.2 instead of the source's 60, same property). L_ref is a multiple
+    // of dx, so that both lattices (anchored at the left end) share nodes.
+    const double L_ref = lp.dx * std::ceil((0.5 * (chi * T + L + 1.) + 1.) / lp.dx);
     const ScalarFunctionFromFunctionObject<1> u0(
       [](const Point<1> &p) { return std::exp(-20. * std::log(2.) * p[0] * p[0]); });
     WaveAbcParameters prm;
@@ -661,10 +662,12 @@ namespace
                 << ", energy increase " << sci(max_energy_increase(h.total_energy)) << std::endl;
     check(h.stats.max_condition_number <= 1e12 && h.stats.max_update_norm <= 2. && h.stats.n_thinned == 0,
           "guards: cond <= 1e12, max|V| <= 2 without thinning (the source: no node reduction needed)");
-    // The source shows only a figure (truncated ~ reference); asserted is
-    // the criterion: at least 10x closer to the reference than the
-    // free truncation over the whole run (measured CI 1.09e-2 vs 0.666).
-    check(err < 0.1 * err_free, "E12c: max |u - u_ref| at least 10x below the free truncation: " + sci(err) + " vs " + sci(err_free));
+    // The source shows only a figure (truncated ~ reference, Fig. 4.27);
+    // asserted: the criterion (at least 10x closer to the reference
+    // than the free truncation over the whole run) and an absolute bound
+    // 1e-3 max|u0|, about 3x the measured CI value (3.5e-4 vs free 0.67).
+    check(err < 0.1 * err_free && err < 1e-3,
+          "E12c: max |u - u_ref| < 1e-3 and at least 10x below the free truncation: " + sci(err) + " vs " + sci(err_free));
     check(max_energy_increase(h.total_energy) <= 0., "E12c: energy non-increasing");
     if (!full && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
       {
