@@ -57,7 +57,9 @@ namespace PeriDEAL
       double max_update_norm = 2.;
       /**
        * Relative singular-value cutoff of the pseudo-inverse (0: Eigen's
-       * default rank threshold max(rows, cols) * epsilon).
+       * default rank threshold max(rows, cols) * epsilon); LAPACK's rcond.
+       * The condition number guard is evaluated over the retained singular
+       * values (E12c: 1e-12).
        */
       double pseudo_inverse_tolerance = 0.;
       /**
