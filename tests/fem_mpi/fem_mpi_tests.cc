@@ -206,7 +206,8 @@ namespace
     diffusion_case("square Q1 lumped forward Euler", square(2., 32), fp, 0.25, 200);
     // Measured: with dt = 1e-2 (D dt / h^2 = 0.64) the 2D EBF + backward
     // Euler run diverges within 50 steps (Q1 and Q2, lumped or consistent);
-    // dt = 2e-3 and 5e-3 do not.
+    // dt = 2e-3 and 5e-3 do not. The setup now rejects it
+    // (fem_abc.backward_euler_guard).
     fp.degree      = 2;
     fp.lumped_mass = false;
     fp.scheme      = "backward Euler";
