@@ -323,18 +323,23 @@ namespace
    * 18 (nothing reflected there is back before t = 16) and the first-order
    * ABC on the same disk.
    */
-  void
-  disk_wave()
+  /** Max energy and probe differences of the EBF and first-order runs on a disk near field. */
+  struct DiskWaveResult
   {
-    const double           R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    double e_ebf = 0., e_first = 0., p_ebf = 0., p_first = 0.;
+  };
+
+  DiskWaveResult
+  run_disk_wave(const MeshMaker &near_mesh, const MeshMaker &far_mesh, const double R, const double T,
+                const Abc::WaveAbcParameters &ap)
+  {
     Fem::FemWaveParameters fp;
     fp.damping   = 0.0125;
     fp.time_step = 0.02;
-    Abc::WaveAbcParameters                    ap = e13_abc("local");
     const ScalarFunctionFromFunctionObject<2> u0(pulse);
     Triangulation<2>                          near, far;
-    disk(R, 5)(near);
-    disk(R_ref, 6)(far);
+    near_mesh(near);
+    far_mesh(far);
     Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0);
     Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, ap, u0);
     Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, ap, u0);
@@ -347,7 +352,7 @@ namespace
     const double       e0      = ref.energy(inside);
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
     const Point<2>     probe(0.625 * R, 0.3125 * R);
-    double             e_ebf = 0., e_first = 0., p_ebf = 0., p_first = 0.;
+    DiskWaveResult     r;
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
         ref.advance();
@@ -356,26 +361,77 @@ namespace
         if (s % (n_steps / 16) == 0)
           {
             const double er = ref.energy(inside);
-            e_ebf           = std::max(e_ebf, std::abs(ebf.energy(inside) - er) / e0);
-            e_first         = std::max(e_first, std::abs(first.energy(inside) - er) / e0);
+            r.e_ebf         = std::max(r.e_ebf, std::abs(ebf.energy(inside) - er) / e0);
+            r.e_first       = std::max(r.e_first, std::abs(first.energy(inside) - er) / e0);
             const double ur = ref.value_at(probe);
-            p_ebf           = std::max(p_ebf, std::abs(ebf.value_at(probe) - ur));
-            p_first         = std::max(p_first, std::abs(first.value_at(probe) - ur));
+            r.p_ebf         = std::max(r.p_ebf, std::abs(ebf.value_at(probe) - ur));
+            r.p_first       = std::max(r.p_first, std::abs(first.value_at(probe) - ur));
           }
       }
     if (root())
-      std::cout << "  disk R = 8, t = 16: max |E - E_ref|/E0 EBF " << sci(e_ebf) << " first-order " << sci(e_first)
-                << " (ratio " << e_first / e_ebf << "); probe EBF " << sci(p_ebf) << " first-order " << sci(p_first)
-                << " (ratio " << p_first / p_ebf << ")" << std::endl;
+      std::cout << "  disk R = " << R << ", t = " << T << ": max |E - E_ref|/E0 EBF " << sci(r.e_ebf)
+                << " first-order " << sci(r.e_first) << " (ratio " << r.e_first / r.e_ebf << "); probe EBF "
+                << sci(r.p_ebf) << " first-order " << sci(r.p_first) << " (ratio " << r.p_first / r.p_ebf << ")"
+                << std::endl;
+    return r;
+  }
+
+  MeshMaker
+  balanced_disk(const double R, const unsigned int refinements)
+  {
+    return [=](Triangulation<2> &t) {
+      GridGenerator::hyper_ball_balanced(t, Point<2>(), R);
+      t.refine_global(refinements);
+    };
+  }
+
+  void
+  disk_wave_scan()
+  {
+    const double R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    for (const bool balanced : {false, true})
+      for (const double cr : {0., 0.8, 1.0})
+        for (const double cone : {0.5, 0.25})
+          {
+            Abc::WaveAbcParameters ap = e13_abc("local");
+            ap.cloud_radius           = cr;
+            ap.cone_angle             = cone;
+            if (root())
+              std::cout << (balanced ? "balanced" : "hyper_ball") << " cr " << cr << " cone " << cone << std::endl;
+            try
+              {
+                if (balanced)
+                  run_disk_wave(balanced_disk(R, 4), balanced_disk(R_ref, 5), R, T, ap);
+                else
+                  run_disk_wave(disk(R, 5), disk(R_ref, 6), R, T, ap);
+              }
+            catch (const ParameterError &e)
+              {
+                std::cout << std::string(e.what()).substr(0, 200) << std::endl;
+              }
+          }
+  }
+
+  /**
+   * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
+   * velocity Verlet, local dispersion) against the extended disk of radius
+   * 18 (nothing reflected there is back before t = 16) and the first-order
+   * ABC on the same disk.
+   */
+  void
+  disk_wave()
+  {
+    const double R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    const auto   r = run_disk_wave(disk(R, 5), disk(R_ref, 6), R, T, e13_abc("local"));
     // NOT reproduced on the disk: measured EBF 1.36e-2 vs first-order
     // 1.16e-2 (energy), probe 0.107 vs 0.043; the default clouds have 2-3
     // points only (hyper_ball cells), and larger clouds (d_inf = 0.8, 1.2)
     // diverge (energy errors 0.44, 5e5). Asserted is what was measured:
     // the first-order ABC within 2e-2, the EBF run bounded (< 2e-2, probe
     // < 0.15).
-    check(e_first < 2e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(e_first) + " < 2e-2");
-    check(e_ebf < 2e-2 && p_ebf < 0.15,
-          "disk EBF bounded: max |E - E_ref|/E0 = " + sci(e_ebf) + " < 2e-2, probe " + sci(p_ebf) + " < 0.15");
+    check(r.e_first < 2e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(r.e_first) + " < 2e-2");
+    check(r.e_ebf < 2e-2 && r.p_ebf < 0.15,
+          "disk EBF bounded: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 2e-2, probe " + sci(r.p_ebf) + " < 0.15");
   }
 } // namespace
 
@@ -385,5 +441,5 @@ main(int argc, char **argv)
   return run(argc, argv,
              {{"rank_invariance_diffusion", rank_invariance_diffusion},
               {"disk_diffusion", disk_diffusion},
-              {"disk_wave", disk_wave}, {"rank_invariance_wave", rank_invariance_wave}});
+              {"disk_wave", disk_wave}, {"disk_wave_scan", disk_wave_scan}, {"rank_invariance_wave", rank_invariance_wave}});
 }
