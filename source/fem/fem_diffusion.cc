@@ -335,5 +335,6 @@ namespace PeriDEAL
 
     template class FemDiffusion<1>;
     template class FemDiffusion<2>;
+    template class FemDiffusion<3>;
   } // namespace Fem
 } // namespace PeriDEAL

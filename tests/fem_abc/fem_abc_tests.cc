@@ -414,7 +414,10 @@ namespace
    * falls to 1.6e-17 E0 at t = 400. Asserted: no increase above 1e-10 E0
    * between samples (the issue's "non-increasing" holds to that level) and
    * no growth: every sample of the second half below 1e-12 E0 (measured
-   * 1.1e-13; a growing mode would show there).
+   * 1.1e-13; a growing mode would show there). 1e6 steps (t = 2e4): E
+   * settles at 6.1e-18 E0 (a non-decaying near-constant state of the
+   * constant-preserving update) and stays there, largest increase between
+   * samples 1.3e-20 E0: no growth over 1e6 steps.
    */
   void
   newmark_energy_decay(const unsigned int n_steps, const unsigned int every)
@@ -440,12 +443,7 @@ namespace
           {
             const double e = w.energy(all);
             if (e > previous)
-              {
-                ++n_increase;
-                if (root())
-                  std::cout << "    increase at step " << s << ": " << sci(previous / e0) << " -> " << sci(e / e0)
-                            << std::endl;
-              }
+              ++n_increase;
             max_increase = std::max(max_increase, (e - previous) / e0);
             if (2 * s > n_steps)
               max_after = std::max(max_after, e / e0);
