@@ -274,9 +274,12 @@ namespace PeriDEAL
 
     template class NearFieldLayout<1>;
     template class NearFieldLayout<2>;
+    template class NearFieldLayout<3>;
     template std::vector<std::pair<Point<1>, double>>
     gather_by_point(const NearFieldLayout<1> &, const DistributedVector &);
     template std::vector<std::pair<Point<2>, double>>
     gather_by_point(const NearFieldLayout<2> &, const DistributedVector &);
+    template std::vector<std::pair<Point<3>, double>>
+    gather_by_point(const NearFieldLayout<3> &, const DistributedVector &);
   } // namespace Fem
 } // namespace PeriDEAL

@@ -1,5 +1,5 @@
 perideal_add_test_program(fem_abc_tests ${CMAKE_CURRENT_LIST_DIR}/fem_abc_tests.cc)
-foreach(_t constant_state spectral_radius bad_input)
+foreach(_t constant_state spectral_radius bad_input backward_euler_guard)
   perideal_add_test(NAME fem_abc.${_t} COMMAND $<TARGET_FILE:fem_abc_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME fem_abc.e13 COMMAND $<TARGET_FILE:fem_abc_tests> e13 LABELS convergence)
@@ -7,3 +7,7 @@ perideal_add_test(NAME fem_abc.e13 COMMAND $<TARGET_FILE:fem_abc_tests> e13 LABE
 perideal_add_test(NAME fem_abc.newmark_spectral_radius COMMAND $<TARGET_FILE:fem_abc_tests> newmark_spectral_radius LABELS unit)
 # E13 with Newmark + consistent mass (80 s: two KLU-factorized systems, 1600 steps).
 perideal_add_test(NAME fem_abc.newmark_e13 COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13 LABELS "convergence;long" TIMEOUT 1200)
+# Long-run stability of FEM waves with the EBF ABC (Newmark, consistent mass):
+# 2e4 steps in CI, 1e6 steps (issue 4) in the long test.
+perideal_add_test(NAME fem_abc.newmark_energy_decay COMMAND $<TARGET_FILE:fem_abc_tests> newmark_energy_decay_short LABELS unit)
+perideal_add_test(NAME fem_abc.newmark_energy_decay_long COMMAND $<TARGET_FILE:fem_abc_tests> newmark_energy_decay_long LABELS long TIMEOUT 3000)

@@ -21,6 +21,7 @@
 #include "../check.h"
 
 #include <cmath>
+#include <array>
 #include <functional>
 
 using namespace dealii;
@@ -206,7 +207,8 @@ namespace
     diffusion_case("square Q1 lumped forward Euler", square(2., 32), fp, 0.25, 200);
     // Measured: with dt = 1e-2 (D dt / h^2 = 0.64) the 2D EBF + backward
     // Euler run diverges within 50 steps (Q1 and Q2, lumped or consistent);
-    // dt = 2e-3 and 5e-3 do not.
+    // dt = 2e-3 and 5e-3 do not. The setup now rejects it
+    // (fem_abc.backward_euler_guard).
     fp.degree      = 2;
     fp.lumped_mass = false;
     fp.scheme      = "backward Euler";
@@ -316,24 +318,28 @@ namespace
     check(err_ebf < 4e-3, "disk EBF: max |C - heat kernel| = " + sci(err_ebf) + " < 4e-3");
   }
 
-  /**
-   * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
-   * velocity Verlet, local dispersion) against the extended disk of radius
-   * 18 (nothing reflected there is back before t = 16) and the first-order
-   * ABC on the same disk.
-   */
-  void
-  disk_wave()
+  /** Max energy and probe differences of the EBF and first-order runs on a disk near field. */
+  struct DiskWaveResult
   {
-    const double           R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    double e_ebf = 0., e_first = 0., p_ebf = 0., p_first = 0.;
+  };
+
+  DiskWaveResult
+  run_disk_wave(const MeshMaker &near_mesh, const MeshMaker &far_mesh, const double R, const double T,
+                const Abc::WaveAbcParameters &ap, const bool newmark = false)
+  {
     Fem::FemWaveParameters fp;
     fp.damping   = 0.0125;
     fp.time_step = 0.02;
-    Abc::WaveAbcParameters                    ap = e13_abc("local");
+    if (newmark)
+      {
+        fp.scheme      = "Newmark";
+        fp.lumped_mass = false;
+      }
     const ScalarFunctionFromFunctionObject<2> u0(pulse);
     Triangulation<2>                          near, far;
-    disk(R, 5)(near);
-    disk(R_ref, 6)(far);
+    near_mesh(near);
+    far_mesh(far);
     Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0);
     Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, ap, u0);
     Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, ap, u0);
@@ -346,7 +352,7 @@ namespace
     const double       e0      = ref.energy(inside);
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
     const Point<2>     probe(0.625 * R, 0.3125 * R);
-    double             e_ebf = 0., e_first = 0., p_ebf = 0., p_first = 0.;
+    DiskWaveResult     r;
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
         ref.advance();
@@ -355,26 +361,164 @@ namespace
         if (s % (n_steps / 16) == 0)
           {
             const double er = ref.energy(inside);
-            e_ebf           = std::max(e_ebf, std::abs(ebf.energy(inside) - er) / e0);
-            e_first         = std::max(e_first, std::abs(first.energy(inside) - er) / e0);
+            r.e_ebf         = std::max(r.e_ebf, std::abs(ebf.energy(inside) - er) / e0);
+            r.e_first       = std::max(r.e_first, std::abs(first.energy(inside) - er) / e0);
             const double ur = ref.value_at(probe);
-            p_ebf           = std::max(p_ebf, std::abs(ebf.value_at(probe) - ur));
-            p_first         = std::max(p_first, std::abs(first.value_at(probe) - ur));
+            r.p_ebf         = std::max(r.p_ebf, std::abs(ebf.value_at(probe) - ur));
+            r.p_first       = std::max(r.p_first, std::abs(first.value_at(probe) - ur));
           }
       }
     if (root())
-      std::cout << "  disk R = 8, t = 16: max |E - E_ref|/E0 EBF " << sci(e_ebf) << " first-order " << sci(e_first)
-                << " (ratio " << e_first / e_ebf << "); probe EBF " << sci(p_ebf) << " first-order " << sci(p_first)
-                << " (ratio " << p_first / p_ebf << ")" << std::endl;
+      std::cout << "  disk R = " << R << ", t = " << T << ": max |E - E_ref|/E0 EBF " << sci(r.e_ebf)
+                << " first-order " << sci(r.e_first) << " (ratio " << r.e_first / r.e_ebf << "); probe EBF "
+                << sci(r.p_ebf) << " first-order " << sci(r.p_first) << " (ratio " << r.p_first / r.p_ebf << ")"
+                << std::endl;
+    return r;
+  }
+
+  /**
+   * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
+   * velocity Verlet, local dispersion) against the extended disk of radius
+   * 18 (nothing reflected there is back before t = 16) and the first-order
+   * ABC on the same disk.
+   */
+  void
+  disk_wave()
+  {
+    const double R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    const auto   r = run_disk_wave(disk(R, 5), disk(R_ref, 6), R, T, e13_abc("local"));
     // NOT reproduced on the disk: measured EBF 1.36e-2 vs first-order
-    // 1.16e-2 (energy), probe 0.107 vs 0.043; the default clouds have 2-3
-    // points only (hyper_ball cells), and larger clouds (d_inf = 0.8, 1.2)
-    // diverge (energy errors 0.44, 5e5). Asserted is what was measured:
+    // 1.16e-2 (energy), probe 0.107 vs 0.043; the default clouds (d_inf =
+    // 2 h with h the largest minimum vertex distance, smaller than the
+    // 0.39 boundary spacing) have 2-3 points only, all behind along the
+    // normal. Session-6 scan (energy error, first-order 1.16e-2):
+    //   hyper_ball d_inf 0.8 / 1.0, cone 0.5: 0.44 / 1.18 (clouds 8-12 / 7-18);
+    //   cone 0.25: 3.9e5 / 8.5e15 (diverge);
+    //   hyper_ball_balanced (4 ref.), default / 0.8 / 1.0: 2.8e-2 / 6.0 / 2.3e4
+    //   (first-order 1.6e-2);
+    //   Newmark + consistent mass (stable on squares): 1.36e-2 / 0.45 / 1.20,
+    //   the same as Verlet: the time integrator and the lumping are not the
+    //   cause, the extrapolation on the curved boundary's clouds is.
+    // Asserted is what was measured:
     // the first-order ABC within 2e-2, the EBF run bounded (< 2e-2, probe
     // < 0.15).
-    check(e_first < 2e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(e_first) + " < 2e-2");
-    check(e_ebf < 2e-2 && p_ebf < 0.15,
-          "disk EBF bounded: max |E - E_ref|/E0 = " + sci(e_ebf) + " < 2e-2, probe " + sci(p_ebf) + " < 0.15");
+    check(r.e_first < 2e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(r.e_first) + " < 2e-2");
+    check(r.e_ebf < 2e-2 && r.p_ebf < 0.15,
+          "disk EBF bounded: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 2e-2, probe " + sci(r.p_ebf) + " < 0.15");
+  }
+  /** 3D heat kernel of C0 = exp(-4 |x|^2), D = 1. */
+  class HeatKernel3d : public Function<3>
+  {
+  public:
+    double
+    value(const Point<3> &p, const unsigned int = 0) const override
+    {
+      const double s = 1. + 16. * this->get_time();
+      return std::exp(-4. * p.square() / s) / std::pow(s, 1.5);
+    }
+  };
+
+  /**
+   * 3D FEM diffusion (Q1 lumped, forward Euler, D = 1) of C0 = exp(-4|x|^2)
+   * with the octant-frame EBF ABC (4.24) on a cube (-L, L)^3 or a ball of
+   * radius L (GridGenerator::hyper_ball) against the heat kernel: energy
+   * Pi(t) = integral of C^2 over the near field in closed form (cube:
+   * s^-3 (sqrt(pi s/8) erf(L sqrt(8/s)))^3; ball: 4 pi s^-3 (sqrt(pi)/(4 a^1.5)
+   * erf(sqrt(a) L) - L exp(-a L^2)/(2a)), a = 8/s, s = 1 + 16 t) and the max
+   * pointwise error; the same mesh with Neumann truncation as the baseline.
+   */
+  std::array<double, 4>
+  diffusion_3d(const bool ball, const double L, const unsigned int refinements, const double t_end,
+               const double dt, const double cloud_radius, const std::string &fit = "least squares")
+  {
+    Triangulation<3> tria;
+    if (ball)
+      GridGenerator::hyper_ball(tria, Point<3>(), L);
+    else
+      GridGenerator::hyper_cube(tria, -L, L);
+    tria.refine_global(refinements);
+    Fem::FemDiffusionParameters fp;
+    fp.time_step = dt;
+    Abc::EbfParameters ap;
+    ap.cloud_radius = cloud_radius;
+    ap.fit          = fit;
+    HeatKernel3d         c0;
+    Fem::FemDiffusion<3> ebf(tria, fp), neumann(tria, fp);
+    ebf.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+    neumann.setup(Abc::TruncationBoundary::neumann, ap, c0);
+    const auto &st = ebf.absorbing_boundary().statistics();
+    if (root())
+      std::cout << "  " << (ball ? "ball" : "cube") << " L = " << L << ": " << ebf.get_dof_handler().n_dofs()
+                << " DoFs, " << st.n_absorbing << " absorbing, clouds " << st.min_cloud_size << ".."
+                << st.max_cloud_size << ", cond " << sci(st.max_condition_number) << ", max |V| "
+                << sci(st.max_update_norm) << ", growth check " << ebf.stability_growth << std::endl;
+    const auto exact_energy = [ball, L](const double t) {
+      const double s = 1. + 16. * t, a = 8. / s;
+      if (ball)
+        return 4. * M_PI / (s * s * s) *
+               (std::sqrt(M_PI) / (4. * std::pow(a, 1.5)) * std::erf(std::sqrt(a) * L) -
+                L * std::exp(-a * L * L) / (2. * a));
+      return std::pow(std::sqrt(M_PI / a) * std::erf(L * std::sqrt(a)), 3) / (s * s * s);
+    };
+    const BoundingBox<3> all(std::make_pair(Point<3>(-L, -L, -L), Point<3>(L, L, L)));
+    const double         e0      = exact_energy(0.);
+    double               max_ebf = 0., end_ebf = 0., end_neumann = 0.;
+    const unsigned int   n_steps = static_cast<unsigned int>(std::round(t_end / dt));
+    for (unsigned int s = 1; s <= n_steps; ++s)
+      {
+        ebf.advance();
+        neumann.advance();
+        if (s % (n_steps / 10) == 0 || s == n_steps)
+          {
+            const double ee = exact_energy(ebf.time());
+            end_ebf         = std::abs(ebf.energy(all) - ee) / e0;
+            end_neumann     = std::abs(neumann.energy(all) - ee) / e0;
+            max_ebf         = std::max(max_ebf, end_ebf);
+          }
+      }
+    HeatKernel3d exact;
+    const double err = ebf.max_error(exact, all);
+    if (root())
+      std::cout << "  " << (ball ? "ball" : "cube") << ", t = " << t_end << ": |Pi - Pi_exact|/Pi0 EBF max "
+                << sci(max_ebf) << " end " << sci(end_ebf) << ", Neumann end " << sci(end_neumann) << " (ratio "
+                << end_neumann / end_ebf << "); max |C - heat kernel| EBF " << sci(err) << std::endl;
+    return {max_ebf, end_ebf, end_neumann, err};
+  }
+
+  /**
+   * 3D FEM diffusion with the EBF ABC, t = 0.5, dt = 1e-3, d_inf = 0.45:
+   * cube (-1.5, 1.5)^3 (16^3 cells, h = 0.1875) and ball of radius 1.5
+   * (hyper_ball, 3 refinements). The least-squares fit (4.31) is unusable
+   * in 3D here (measured: d_inf = 0.38 grows by 2.4 per step and the guard
+   * asks for dt <= 8.8e-6; d_inf = 0.45 / 0.55 violate the |V| guard;
+   * the ball's clouds likewise); the monotone fit (V_j >= 0, sum = 1:
+   * stable for every cloud with forward Euler) is used.
+   */
+  void
+  diffusion_3d_cube_ball()
+  {
+    bool rejected = false;
+    try
+      {
+        diffusion_3d(false, 1.5, 4, 0.5, 1e-3, 0.45, "least squares");
+      }
+    catch (const ParameterError &)
+      {
+        rejected = true;
+      }
+    check(rejected, "3D least-squares clouds rejected by the guards (ParameterError)");
+    const auto cube = diffusion_3d(false, 1.5, 4, 0.5, 1e-3, 0.45, "monotone");
+    // Measured: max 5.3e-3, end 4.1e-3 vs Neumann 4.4e-2 (10.8x), max |C -
+    // heat kernel| 1.1e-2 (h = 0.19 sets the floor). Tolerances ~50 % above;
+    // the ratio 20 % below the measured one.
+    check(cube[0] < 8e-3, "cube: max |Pi - Pi_exact|/Pi0 = " + sci(cube[0]) + " < 8e-3");
+    check(cube[2] > 8.5 * cube[1], "cube: EBF at least 8.5x closer to the heat kernel energy than Neumann at t_end");
+    check(cube[3] < 1.7e-2, "cube: max |C - heat kernel| = " + sci(cube[3]) + " < 1.7e-2");
+    const auto ball = diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "monotone");
+    // Measured: 2.1e-2 vs Neumann 0.117 (5.4x): the 10x of the issue is NOT
+    // reached on the ball (coarse polyhedral ball, 386 absorbing DoFs).
+    check(ball[0] < 3.2e-2, "ball: max |Pi - Pi_exact|/Pi0 = " + sci(ball[0]) + " < 3.2e-2");
+    check(ball[2] > 4. * ball[1], "ball: EBF at least 4x closer than Neumann at t_end (10x not reached)");
   }
 } // namespace
 
@@ -384,5 +528,5 @@ main(int argc, char **argv)
   return run(argc, argv,
              {{"rank_invariance_diffusion", rank_invariance_diffusion},
               {"disk_diffusion", disk_diffusion},
-              {"disk_wave", disk_wave}, {"rank_invariance_wave", rank_invariance_wave}});
+              {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave}});
 }

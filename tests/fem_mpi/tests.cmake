@@ -7,3 +7,5 @@ endforeach()
 foreach(_t disk_diffusion disk_wave)
   perideal_add_test(NAME fem_mpi.${_t} COMMAND $<TARGET_FILE:fem_mpi_tests> ${_t} LABELS convergence)
 endforeach()
+# 3D FEM diffusion with the EBF ABC (octant frame) on a cube and a ball vs the heat kernel.
+perideal_add_test(NAME fem_mpi.diffusion_3d_cube_ball COMMAND $<TARGET_FILE:fem_mpi_tests> diffusion_3d_cube_ball LABELS convergence)

@@ -64,7 +64,13 @@ namespace PeriDEAL
       /**
        * Distribute DoFs, assemble M and K, build the ABC (for @p boundary
        * absorbing; local dispersion with D), interpolate @p initial.
-       * Throws ParameterError if the explicit step is unstable.
+       * Throws ParameterError if the explicit step is unstable, or (absorbing,
+       * EbfParameters::stability_check_steps > 0) if the one-step map with
+       * the ABC grows (power iteration): the ABC extrapolates explicitly
+       * over dt, so even backward Euler has a largest admissible time step,
+       * which depends on the cloud (no closed form: see
+       * doc/design.md, "FEM near field"); the error names FEM/Time step and
+       * the largest stable step found by halving and bisection.
        */
       void
       setup(const Abc::TruncationBoundary boundary,
@@ -110,6 +116,25 @@ namespace PeriDEAL
       {
         return abc;
       }
+      /**
+       * Spectral radius of the one-step map C^n -> C^{n+1} (ABC included),
+       * by a dense eigenvalue problem (serial, at most @p max_size DoFs);
+       * the state is restored afterwards.
+       */
+      double
+      one_step_spectral_radius(const unsigned int max_size = 3000);
+
+      /**
+       * Growth per step of the one-step map by @p n_steps steps of the
+       * power iteration from a random start on the cloud DoFs (the state is
+       * restored afterwards; any number of ranks).
+       */
+      double
+      power_iteration_growth(const unsigned int n_steps);
+
+      /** Growth measured by the setup's stability check (0: not run). */
+      double stability_growth = 0.;
+
       /** Largest stable forward Euler step 2 / lambda_max(M^-1 K) (power iteration). */
       double critical_time_step = 0.;
       /** Wall seconds in the ABC update and in advance(). */
