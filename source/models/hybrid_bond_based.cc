@@ -1,6 +1,6 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/models/hybrid_bond_based.h>
-#include <perideal/models/pmb_bond.h>
+#include <perideal/models/lattice_sweep_kernel.h>
 
 #include <ctime>
 #include <immintrin.h>
@@ -848,7 +848,7 @@ namespace PeriDEAL
             const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
             const __m512d rb = _mm512_set1_pd(sweep_r[f]);
             __mmask8      brk;
-            const __m512d scale = internal::pmb_bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
+            const __m512d scale = internal::LatticeSweep::pmb_bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
                                              _mm512_mul_pd(_mm512_set1_pd(s0), rb), brk);
             for (unsigned int d = 0; d < dim; ++d)
               acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);

@@ -482,7 +482,7 @@ namespace
       std::cout << "  " << (ball ? "ball" : "cube") << ", t = " << t_end << ": |Pi - Pi_exact|/Pi0 EBF max "
                 << sci(max_ebf) << " end " << sci(end_ebf) << ", Neumann end " << sci(end_neumann) << " (ratio "
                 << end_neumann / end_ebf << "); max |C - heat kernel| EBF " << sci(err) << std::endl;
-    return {max_ebf, end_ebf, end_neumann, err};
+    return {{max_ebf, end_ebf, end_neumann, err}};
   }
 
   /**
