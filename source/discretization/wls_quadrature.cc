@@ -252,23 +252,8 @@ namespace PeriDEAL
                            const double              delta,
                            const MonomialBasis<dim> &basis)
   {
-    const unsigned int  np = basis.size();
-    std::vector<double> rows(dim * dim * np, 0.);
-    for (unsigned int a = 0; a < dim; ++a)
-      for (unsigned int b = 0; b < dim; ++b)
-        for (unsigned int al = 1; al < np; ++al)
-          {
-            // c omega xi_a xi_b / r^3 xi^alpha: radial power |alpha| + 2 - 3 + dim - 1.
-            auto e = basis.exponents(al);
-            ++e[a];
-            ++e[b];
-            const double ang = sphere_monomial_integral<dim>(e);
-            if (ang != 0.)
-              rows[(a * dim + b) * np + al] =
-                micromodulus * ang *
-                radial_power_integral(omega, delta, basis.degree_of(al) + dim - 2.);
-          }
-    return rows;
+    // c omega xi_a xi_b / r^3: the pair tensor with s = 3.
+    return pair_tensor_operator_rows(micromodulus, omega, delta, 3., basis);
   }
 
   template <int dim>

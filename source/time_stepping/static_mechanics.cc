@@ -64,6 +64,22 @@ namespace PeriDEAL
         return v;
       };
     }
+
+    // AMG for the PD stiffness K with the translations per component as the
+    // near-null space (DoFs interleaved by component).
+    template <int dim>
+    void
+    initialize_elasticity_amg(TrilinosWrappers::PreconditionAMG    &amg,
+                              const TrilinosWrappers::SparseMatrix &K,
+                              const IndexSet                       &owned)
+    {
+      TrilinosWrappers::PreconditionAMG::AdditionalData data;
+      data.elliptic = true;
+      data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
+      for (unsigned int k = 0; k < owned.n_elements(); ++k)
+        data.constant_modes[k % dim][k] = true;
+      amg.initialize(K, data);
+    }
   } // namespace
 
   template <int dim>
@@ -488,13 +504,8 @@ namespace PeriDEAL
         };
         SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData gmres_data(300, true);
         SolverGMRES<TrilinosWrappers::MPI::Vector> gmres(control, gmres_data);
-        TrilinosWrappers::PreconditionAMG                 amg;
-        TrilinosWrappers::PreconditionAMG::AdditionalData data;
-        data.elliptic = true;
-        data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
-        for (unsigned int k = 0; k < owned.n_elements(); ++k)
-          data.constant_modes[k % dim][k] = true;
-        amg.initialize(K, data);
+        TrilinosWrappers::PreconditionAMG amg;
+        initialize_elasticity_amg<dim>(amg, K, owned);
         gmres.solve(system, x, rhs, amg);
         iterations = control.last_step();
         system.vmult(res, x);
@@ -512,14 +523,8 @@ namespace PeriDEAL
       }
     else
       {
-        TrilinosWrappers::PreconditionAMG                 amg;
-        TrilinosWrappers::PreconditionAMG::AdditionalData data;
-        data.elliptic = true;
-        // Translations per component as the near-null space.
-        data.constant_modes.assign(dim, std::vector<bool>(owned.n_elements(), false));
-        for (unsigned int k = 0; k < owned.n_elements(); ++k)
-          data.constant_modes[k % dim][k] = true;
-        amg.initialize(K, data);
+        TrilinosWrappers::PreconditionAMG amg;
+        initialize_elasticity_amg<dim>(amg, K, owned);
         TrilinosWrappers::SolverCG cg(control);
         cg.solve(K, x, rhs, amg);
         iterations = control.last_step();
