@@ -66,7 +66,8 @@ namespace PeriDEAL
        * absorbing; local dispersion with D), interpolate @p initial.
        * Throws ParameterError if the explicit step is unstable, or (absorbing,
        * EbfParameters::stability_check_steps > 0) if the one-step map with
-       * the ABC grows (power iteration): the ABC extrapolates explicitly
+       * the ABC grows (spectral radius above 1 + 1e-5 by
+       * arnoldi_spectral_radius(steps / 4, 60)): the ABC extrapolates explicitly
        * over dt, so even backward Euler has a largest admissible time step,
        * which depends on the cloud (no closed form: see
        * doc/design.md, "FEM near field"); the error names FEM/Time step and
@@ -132,7 +133,16 @@ namespace PeriDEAL
       double
       power_iteration_growth(const unsigned int n_steps);
 
-      /** Growth measured by the setup's stability check (0: not run). */
+      /**
+       * Spectral radius of the one-step map (ABC included) estimated by
+       * Arnoldi: @p n_warm power-iteration steps from the random cloud start
+       * of power_iteration_growth(), then @p n_krylov Arnoldi steps (modified
+       * Gram-Schmidt, reorthogonalized); the largest Ritz value modulus of
+       * the Hessenberg matrix. Any number of ranks; the state is restored.
+       */
+      double
+      arnoldi_spectral_radius(const unsigned int n_warm, const unsigned int n_krylov);
+      /** Spectral radius (Arnoldi) measured by the setup's stability check (0: not run). */
       double stability_growth = 0.;
 
       /** Largest stable forward Euler step 2 / lambda_max(M^-1 K) (power iteration). */
@@ -141,6 +151,9 @@ namespace PeriDEAL
       double abc_seconds = 0., step_seconds = 0.;
 
     private:
+      /** C = the pseudo-random start on the owned cloud DoFs (seeded by global id), normalized. */
+      void
+      random_cloud_start();
       const Triangulation<dim>      &tria;
       FemDiffusionParameters         prm;
       FE_Q<dim>                      fe;
