@@ -399,6 +399,12 @@ namespace
     //   Newmark + consistent mass (stable on squares): 1.36e-2 / 0.45 / 1.20,
     //   the same as Verlet: the time integrator and the lumping are not the
     //   cause, the extrapolation on the curved boundary's clouds is.
+    // Session 7: the reference is not the cause (disk(18.5, 6) vs
+    // disk(18.5, 7): energy 1.8e-3, probe 2.9e-4; first-order vs the finer
+    // reference 1.17e-2 as before). One time level 1.54e-2, Delta phi
+    // 0.2 / 0.6 1.20e-2 / 1.37e-2, Delta k 0.5 / 2 1.25e-2 / 0.46, n_k 4
+    // 1.41e-2, n_phi 4 1.36e-2, cone 0.8 with d_inf 0.6 (5-6 points)
+    // 1.19e-2, pseudo-inverse cutoff 1e-3 1.55e-2: none below first order.
     // Asserted is what was measured:
     // the first-order ABC within 2e-2, the EBF run bounded (< 2e-2, probe
     // < 0.15).
@@ -427,7 +433,7 @@ namespace
    * erf(sqrt(a) L) - L exp(-a L^2)/(2a)), a = 8/s, s = 1 + 16 t) and the max
    * pointwise error; the same mesh with Neumann truncation as the baseline.
    */
-  std::array<double, 4>
+  std::array<double, 6>
   diffusion_3d(const bool ball, const double L, const unsigned int refinements, const double t_end,
                const double dt, const double cloud_radius, const std::string &fit = "least squares")
   {
@@ -478,11 +484,26 @@ namespace
       }
     HeatKernel3d exact;
     const double err = ebf.max_error(exact, all);
+    // Boundary DoFs at t_end where the EBF value lies below the heat kernel
+    // (the monotone update cannot fall below its cloud's minimum).
+    exact.set_time(ebf.time());
+    unsigned int n_below = 0;
+    double       min_excess = std::numeric_limits<double>::max();
+    for (const unsigned int l : ebf.layout().boundary)
+      {
+        const double excess = ebf.solution().local_element(l) - exact.value(ebf.layout().points[l]);
+        n_below += excess < 0. ? 1 : 0;
+        min_excess = std::min(min_excess, excess / exact.value(ebf.layout().points[l]));
+      }
+    if (root())
+      std::cout << "  " << (ball ? "ball" : "cube") << ", t = " << t_end << ": " << n_below << " of "
+                << ebf.layout().boundary.size() << " boundary DoFs below the heat kernel, min (C - exact)/exact "
+                << sci(min_excess) << std::endl;
     if (root())
       std::cout << "  " << (ball ? "ball" : "cube") << ", t = " << t_end << ": |Pi - Pi_exact|/Pi0 EBF max "
                 << sci(max_ebf) << " end " << sci(end_ebf) << ", Neumann end " << sci(end_neumann) << " (ratio "
                 << end_neumann / end_ebf << "); max |C - heat kernel| EBF " << sci(err) << std::endl;
-    return {{max_ebf, end_ebf, end_neumann, err}};
+    return {{max_ebf, end_ebf, end_neumann, err, double(n_below), min_excess}};
   }
 
   /**
@@ -516,9 +537,28 @@ namespace
     check(cube[3] < 1.7e-2, "cube: max |C - heat kernel| = " + sci(cube[3]) + " < 1.7e-2");
     const auto ball = diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "monotone");
     // Measured: 2.1e-2 vs Neumann 0.117 (5.4x): the 10x of the issue is NOT
-    // reached on the ball (coarse polyhedral ball, 386 absorbing DoFs).
+    // reached on the ball. Session 7: not the geometry (heat-kernel energy
+    // over the Q1 mesh vs the sphere: 2e-4 Pi0) nor the mesh (the exact
+    // heat kernel as boundary values: 2.6e-4 Pi0 at t_end, max error
+    // 2.8e-4), but the monotone fit itself: V_j >= 0, sum V_j = 1 makes
+    // C_i^{n+1} a convex combination of its cloud, and on a sphere centred
+    // at the pulse the boundary is a level set with C rising inward, so
+    // C_i cannot decrease, while the heat kernel at r = 1.5 decreases for
+    // t > (8 r^2/3 - 1)/16 = 0.31 (the curvature term 2 C_r / r outweighs
+    // C_rr); the error grows from t = 0.25 on. On the cube the face
+    // neighbours carry smaller values. Signed fits that could extrapolate
+    // are unstable here (Arnoldi radius: least squares 1.31, bounded with
+    // l1 excess 0.05 1.0033, with modes radial about x_i - R n 1.14 /
+    // 1.018); d_inf, Delta k, n_k, n_phi scans (0.45/0.6, 2..8, 5/20,
+    // 2..9) give 2.1e-2 .. 4.3e-2, one outlier 5.1e-3 (d_inf 0.6, Delta k 8);
+    // adding the time-decaying exact solutions cos(k d.x) exp(-D k^2 t) to
+    // the monotone fit makes both worse (cube 1.5e-2, ball 3.1e-2).
     check(ball[0] < 3.2e-2, "ball: max |Pi - Pi_exact|/Pi0 = " + sci(ball[0]) + " < 3.2e-2");
     check(ball[2] > 4. * ball[1], "ball: EBF at least 4x closer than Neumann at t_end (10x not reached)");
+    // The mechanism (measured: all 386 boundary values above the heat
+    // kernel at t_end, by 29 % or more; on the cube 910 of 1538 below).
+    check(ball[4] == 0. && ball[5] > 0.1,
+          "ball: every EBF boundary value above the heat kernel at t_end (min excess " + sci(ball[5]) + ")");
   }
 } // namespace
 
