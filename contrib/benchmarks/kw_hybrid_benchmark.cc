@@ -214,7 +214,8 @@ main(int argc, char **argv)
             << " s, standard rows " << parts[1] << " s, WLS rows " << parts[2]
             << " s (rest: Verlet update); of the switching test, the bound updates "
             << parts[3] << " s\n"
-            << "  Exact node tests of (3.80): " << hm->n_exact_node_tests() << "\n\n";
+            << "  Exact node tests of (3.80): " << hm->n_exact_node_tests() << " (bond tests "
+            << hm->n_exact_bond_tests() << ")\n\n";
   std::cout << std::setprecision(6) << "kw_hybrid_nodes: " << standard.discretization().n_global()
             << "\nkw_hybrid_m: " << m << "\nkw_hybrid_steps: " << hybrid.integrator().step()
             << "\nkw_hybrid_load_average: " << load[0]
@@ -226,6 +227,7 @@ main(int argc, char **argv)
             << "\nkw_hybrid_wls_rows_seconds: " << parts[2]
             << "\nkw_hybrid_switch_bound_seconds: " << parts[3]
             << "\nkw_hybrid_exact_node_tests: " << hm->n_exact_node_tests()
+            << "\nkw_hybrid_exact_bond_tests: " << hm->n_exact_bond_tests()
             << "\nkw_hybrid_overstretched_bonds: " << overstretched
             << "\nkw_hybrid_crack_angle_standard: " << ms.crack_angle
             << "\nkw_hybrid_crack_angle_adaptive: " << mh.crack_angle
