@@ -87,9 +87,10 @@ namespace PeriDEAL
    * subtracted from the slack against round-off of positions and bounds.
    * The bound of a StretchBudget grows with its reach (the width of the
    * blocks), the slack with the shortest bond; so the bonds are split into
-   * length classes (r_min 2^k, r_min 2^(k+1)] (up to four), each with its
+   * length classes (r_min 4^k, r_min 4^(k+1)] (up to two), each with its
    * own StretchBudget (reach: the class's longest bond) and slack (its
-   * shortest bond), and a node is tested when one class's bound fires.
+   * shortest bond); a node tests (and records) the bonds of each class whose
+   * bound fired, the argument above holding per class.
    * Switching is rank independent: each rank marks the owned end points of
    * its critical bonds (a bond to a ghost is tested on both ranks with
    * bitwise the same length), one global sum tells whether anything is
@@ -382,7 +383,7 @@ namespace PeriDEAL
     /** Per bond table entry: (r (1 + sigma s0))^2, (r (1 + s0))^2, 1 / (r (1 + sigma s0))^2. */
     std::vector<double> critical_length2, breaking_length2, inverse_critical_length2;
     /**
-     * Bonds in length classes (r_min 2^k, r_min 2^(k+1)] (the last one
+     * Bonds in length classes (r_min 4^k, r_min 4^(k+1)] (the last one
      * open), each with its growth bound of the Omega_w nodes' bond lengths
      * since their last exact test, the upper length bound of the class and
      * min r (1 + sigma s0) over it.
