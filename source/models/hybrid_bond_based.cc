@@ -783,6 +783,9 @@ namespace PeriDEAL
             if (((classes >> k) & 1u) == 0)
               continue;
             exact_bond_tests += std::uint64_t(__builtin_popcount(lanes)) * class_offsets[k].size();
+            // First q = max |y|^2 / T^2 only; the (rare) vectors with
+            // q >= 1 - 1e-12 are scanned again for the bonds with
+            // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
             __m512d qmax = _mm512_setzero_pd();
             for (const unsigned int f : class_offsets[k])
               {
@@ -793,26 +796,35 @@ namespace PeriDEAL
                 const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
                 qmax = _mm512_mask_max_pd(qmax, alive, qmax,
                                           _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
-                const __mmask8 hit =
-                  _mm512_mask_cmp_pd_mask(alive, l2, _mm512_set1_pd(sweep_L2[f]), _CMP_GE_OQ);
-                if (__builtin_expect(hit != 0, 0))
-                  {
-                    alignas(64) double l2s[8];
-                    _mm512_store_pd(l2s, l2);
-                    for (unsigned int l = 0; l < 8; ++l)
-                      if ((hit >> l) & 1u)
-                        {
-                          // Both end points, a ghost one too (sent to its owner).
-                          const std::int32_t i = sweep_node[L0 + l],
-                                             j = sweep_node[L0 + l + sweep_offset[f]];
-                          crit[i] = crit[j] = 1.;
-                          ++n_critical;
-                          // Once per bond, as in the row loop below.
-                          if (l2s[l] > sweep_B2[f] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
-                            ++overstretched;
-                        }
-                  }
               }
+            if (__builtin_expect(
+                  _mm512_cmp_pd_mask(qmax, _mm512_set1_pd(1. - 1e-12), _CMP_GE_OQ) != 0, 0))
+              for (const unsigned int f : class_offsets[k])
+                {
+                  const __mmask8 alive = bits[f] & lanes;
+                  if (alive == 0)
+                    continue;
+                  __m512d        y[dim];
+                  const __m512d  l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+                  const __mmask8 hit =
+                    _mm512_mask_cmp_pd_mask(alive, l2, _mm512_set1_pd(sweep_L2[f]), _CMP_GE_OQ);
+                  if (hit == 0)
+                    continue;
+                  alignas(64) double l2s[8];
+                  _mm512_store_pd(l2s, l2);
+                  for (unsigned int l = 0; l < 8; ++l)
+                    if ((hit >> l) & 1u)
+                      {
+                        // Both end points, a ghost one too (sent to its owner).
+                        const std::int32_t i = sweep_node[L0 + l],
+                                           j = sweep_node[L0 + l + sweep_offset[f]];
+                        crit[i] = crit[j] = 1.;
+                        ++n_critical;
+                        // Once per bond, as in the row loop below.
+                        if (l2s[l] > sweep_B2[f] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
+                          ++overstretched;
+                      }
+                }
             alignas(64) double q[8];
             _mm512_store_pd(q, qmax);
             for (unsigned int l = 0; l < 8; ++l)
