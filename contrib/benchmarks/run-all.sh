@@ -17,7 +17,8 @@
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
 #   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 10)
 #   KW_ARGS     options of kw_multiadaptive_benchmark (default: its CI-size case)
-#   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.5 --m 8";
+#   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.25 --m 8",
+#               the source's lattice of Table 3.3;
 #               empty string: skip the Kalthoff-Winkler hybrid case)
 #   SKIP_BUILD  1 to use an existing build
 set -euo pipefail
@@ -292,7 +293,7 @@ if [ -x "$kw_exe" ]; then
 fi
 # Kalthoff-Winkler: standard vs adaptive hybrid (Table 3.3), serial.
 kw_hybrid_exe="$build/contrib/benchmarks/kw_hybrid_benchmark"
-kw_hybrid_args="${KW_HYBRID_ARGS---dx 0.5 --m 8}"
+kw_hybrid_args="${KW_HYBRID_ARGS---dx 0.25 --m 8}"
 if [ -n "$kw_hybrid_args" ] && [ -x "$kw_hybrid_exe" ]; then
   # shellcheck disable=SC2086
   ( cd "$build" && "$kw_hybrid_exe" $kw_hybrid_args --directory "$build/kw-hybrid-benchmark" ) \

@@ -82,7 +82,7 @@ namespace PeriDEAL
     }
 
     /** Most bond length classes of the amortized switching test. */
-    constexpr unsigned int max_classes = 3;
+    constexpr unsigned int max_classes = 2;
 
     /**
      * Exact switching test of one Omega_w row, portable: the number of
@@ -229,8 +229,13 @@ namespace PeriDEAL
       extent = std::max(extent, disc.lattice_size()[d] * disc.parameters().dx);
     const double stretch = 1. + (std::isfinite(s0) ? prm.sigma * s0 : 0.);
     threshold_margin     = 1e-9 * r_min * stretch + 1e-13 * extent;
+    // Length classes (r_min 4^k, r_min 4^(k+1)]: each class costs one
+    // StretchBudget::advance() per test, a finer split fewer exact bond
+    // tests. KW at m = 8 (kw_hybrid_benchmark, dx = 0.25 and 0.5): two
+    // classes split at 4 r_min spend 20-25 % less CPU time in the switching
+    // test than three split at 2 r_min and 4 r_min, or one.
     for (unsigned int k = 0; k < max_classes && (k == 0 || class_bound.back() < r_max); ++k)
-      class_bound.push_back(k + 1 < max_classes ? r_min * std::pow(2., k + 1) * (1. + 1e-9) :
+      class_bound.push_back(k + 1 < max_classes ? r_min * std::pow(4., k + 1) * (1. + 1e-9) :
                                                   std::numeric_limits<double>::max());
     class_bound.back() = std::numeric_limits<double>::max();
     min_threshold.assign(class_bound.size(), std::numeric_limits<double>::max());
@@ -416,6 +421,9 @@ namespace PeriDEAL
             ++k;
           sweep_class[f] = k;
         }
+      class_offsets.assign(class_bound.size(), {});
+      for (unsigned int f = 0; f < n_f; ++f)
+        class_offsets[sweep_class[f]].push_back(f);
       return true;
     }();
     if (Utilities::MPI::min(int(local_ok), disc.get_mpi_communicator()) == 0)
@@ -545,13 +553,14 @@ namespace PeriDEAL
   {
     const auto        &nb = disc.neighborhood;
     const std::size_t  nv = sweep_n_vectors;
-    sweep_live.assign(sweep_offset.size() * nv, 0);
+    const std::size_t  n_f = sweep_offset.size();
+    sweep_live.assign(n_f * nv, 0);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const std::uint32_t L = sweep_position[i];
         for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
           if (broken_flag[b] == 0)
-            sweep_live[sweep_of_box[box_index(i, b)] * nv + L / 8] |= std::uint8_t(1u << (L % 8));
+            sweep_live[(L / 8) * n_f + sweep_of_box[box_index(i, b)]] |= std::uint8_t(1u << (L % 8));
       }
     sweep_live_valid = true;
   }
@@ -634,6 +643,7 @@ namespace PeriDEAL
                 continue;
             }
           ++exact_node_tests;
+          exact_bond_tests += nb.row_start[i + 1] - nb.row_start[i];
           const double       *pi    = p + std::size_t(dim) * i;
           const double       *L2    = critical_length2.data() + nb.table_start[i];
           const double       *iL2   = inverse_critical_length2.data() + nb.table_start[i];
@@ -734,16 +744,17 @@ namespace PeriDEAL
   {
     std::uint64_t n_critical = 0;
 #ifdef PERIDEAL_HYBRID_SWEEP
-    // The Omega_w nodes to test exactly, as lanes of vectors.
+    // The classes to test exactly per vector (bit k: some Omega_w lane's
+    // bound of length class k fired). A class is tested on its own bonds
+    // only: its record bounds only them, and every critical bond of class k
+    // has an Omega_w end whose class-k bound fires (the argument of the
+    // class documentation, per class).
     test_lanes.assign(sweep_n_vectors, 0);
+    const unsigned int n_classes = class_bound.size();
     for (const unsigned int i : active_wls_rows)
-      {
-        bool needed = !prm.switching_bound;
-        for (const auto &b : budget)
-          needed = needed || b.needs_check(i);
-        if (needed)
-          test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
-      }
+      for (unsigned int k = 0; k < n_classes; ++k)
+        if (!prm.switching_bound || budget[k].needs_check(i))
+          test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << k);
     // A vector costs the same for one lane as for eight: test (and record)
     // every Omega_w lane of a vector with one to test. An exact test of a
     // node whose bound has not fired finds nothing critical at it (that is
@@ -752,64 +763,75 @@ namespace PeriDEAL
     test_vectors.clear();
     for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
       if (test_lanes[v])
-        {
-          test_lanes[v] = wls_lanes[v];
-          test_vectors.push_back(v);
-        }
-    const std::size_t   N  = sweep_n_alloc, nv = sweep_n_vectors;
+        test_vectors.push_back(v);
+    const std::size_t   N  = sweep_n_alloc, n_f = sweep_offset.size();
     const double       *p  = sweep_p.data() + sweep_pad;
-    const unsigned int  n_f = sweep_offset.size(), n_classes = class_bound.size();
     double             *crit = critical.begin();
     const std::int32_t *wf   = wls_mask.data();
     for (const std::uint32_t v : test_vectors)
       {
-        const __mmask8    lanes = test_lanes[v];
-        const std::size_t L0    = 8 * std::size_t(v);
+        const __mmask8    lanes   = wls_lanes[v];
+        const unsigned    classes = test_lanes[v];
+        const std::size_t L0      = 8 * std::size_t(v);
         exact_node_tests += __builtin_popcount(lanes);
-        __m512d pi[dim], qmax[max_classes];
+        __m512d pi[dim];
         for (unsigned int d = 0; d < dim; ++d)
           pi[d] = _mm512_loadu_pd(p + d * N + L0);
-        for (unsigned int k = 0; k < max_classes; ++k)
-          qmax[k] = _mm512_setzero_pd();
-        const std::uint8_t *bits = sweep_live.data() + v;
-        for (unsigned int f = 0; f < n_f; ++f)
+        const std::uint8_t *bits = sweep_live.data() + std::size_t(v) * n_f;
+        for (unsigned int k = 0; k < n_classes; ++k)
           {
-            const __mmask8 alive = bits[f * nv] & lanes;
-            if (alive == 0)
+            if (((classes >> k) & 1u) == 0)
               continue;
-            __m512d       y[dim];
-            const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
-            const unsigned int k = sweep_class[f];
-            qmax[k] = _mm512_mask_max_pd(qmax[k], alive, qmax[k],
-                                         _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
-            const __mmask8 hit =
-              _mm512_mask_cmp_pd_mask(alive, l2, _mm512_set1_pd(sweep_L2[f]), _CMP_GE_OQ);
-            if (__builtin_expect(hit != 0, 0))
+            exact_bond_tests += std::uint64_t(__builtin_popcount(lanes)) * class_offsets[k].size();
+            // First q = max |y|^2 / T^2 only; the (rare) vectors with
+            // q >= 1 - 1e-12 are scanned again for the bonds with
+            // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
+            __m512d qmax = _mm512_setzero_pd();
+            for (const unsigned int f : class_offsets[k])
               {
-                alignas(64) double l2s[8];
-                _mm512_store_pd(l2s, l2);
-                for (unsigned int l = 0; l < 8; ++l)
-                  if ((hit >> l) & 1u)
-                    {
-                      // Both end points, a ghost one too (sent to its owner).
-                      const std::int32_t i = sweep_node[L0 + l],
-                                         j = sweep_node[L0 + l + sweep_offset[f]];
-                      crit[i] = crit[j] = 1.;
-                      ++n_critical;
-                      // Once per bond, as in the row loop below.
-                      if (l2s[l] > sweep_B2[f] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
-                        ++overstretched;
-                    }
+                const __mmask8 alive = bits[f] & lanes;
+                if (alive == 0)
+                  continue;
+                __m512d       y[dim];
+                const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+                qmax = _mm512_mask_max_pd(qmax, alive, qmax,
+                                          _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
               }
+            if (__builtin_expect(
+                  _mm512_cmp_pd_mask(qmax, _mm512_set1_pd(1. - 1e-12), _CMP_GE_OQ) != 0, 0))
+              for (const unsigned int f : class_offsets[k])
+                {
+                  const __mmask8 alive = bits[f] & lanes;
+                  if (alive == 0)
+                    continue;
+                  __m512d        y[dim];
+                  const __m512d  l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+                  const __mmask8 hit =
+                    _mm512_mask_cmp_pd_mask(alive, l2, _mm512_set1_pd(sweep_L2[f]), _CMP_GE_OQ);
+                  if (hit == 0)
+                    continue;
+                  alignas(64) double l2s[8];
+                  _mm512_store_pd(l2s, l2);
+                  for (unsigned int l = 0; l < 8; ++l)
+                    if ((hit >> l) & 1u)
+                      {
+                        // Both end points, a ghost one too (sent to its owner).
+                        const std::int32_t i = sweep_node[L0 + l],
+                                           j = sweep_node[L0 + l + sweep_offset[f]];
+                        crit[i] = crit[j] = 1.;
+                        ++n_critical;
+                        // Once per bond, as in the row loop below.
+                        if (l2s[l] > sweep_B2[f] && (wf[j] == 0 || disc.id[i] < disc.id[j]))
+                          ++overstretched;
+                      }
+                }
+            alignas(64) double q[8];
+            _mm512_store_pd(q, qmax);
+            for (unsigned int l = 0; l < 8; ++l)
+              if ((lanes >> l) & 1u)
+                budget[k].record(sweep_node[L0 + l],
+                                 (1. - std::sqrt(q[l])) * min_threshold[k] - threshold_margin);
           }
-        alignas(64) double q[max_classes][8];
-        for (unsigned int k = 0; k < max_classes; ++k)
-          _mm512_store_pd(q[k], qmax[k]);
-        for (unsigned int l = 0; l < 8; ++l)
-          if ((lanes >> l) & 1u)
-            for (unsigned int k = 0; k < n_classes; ++k)
-              budget[k].record(sweep_node[L0 + l],
-                               (1. - std::sqrt(q[k][l])) * min_threshold[k] - threshold_margin);
       }
 #endif
     return n_critical;
@@ -824,7 +846,7 @@ namespace PeriDEAL
     // (both copies of a bond between two Omega_s nodes see the same |y|^2
     // and break together; a bond to Omega_w is evaluated from its Omega_s
     // end only).
-    const std::size_t  N = sweep_n_alloc, nv = sweep_n_vectors;
+    const std::size_t  N = sweep_n_alloc;
     const double      *p = sweep_p.data() + sweep_pad;
     const unsigned int n_f = sweep_offset.size();
     sweep_broken.clear();
@@ -838,10 +860,10 @@ namespace PeriDEAL
             pi[d]  = _mm512_loadu_pd(p + d * N + L0);
             acc[d] = _mm512_setzero_pd();
           }
-        const std::uint8_t *bits = sweep_live.data() + v;
+        const std::uint8_t *bits = sweep_live.data() + std::size_t(v) * n_f;
         for (unsigned int f = 0; f < n_f; ++f)
           {
-            const __mmask8 alive = bits[f * nv] & lanes;
+            const __mmask8 alive = bits[f] & lanes;
             if (alive == 0)
               continue;
             __m512d       y[dim];
@@ -870,8 +892,8 @@ namespace PeriDEAL
       {
         const std::uint32_t M = L + sweep_offset[f];
         const unsigned int  g = sweep_mirror[f];
-        sweep_live[f * nv + L / 8] &= std::uint8_t(~(1u << (L % 8)));
-        sweep_live[g * nv + M / 8] &= std::uint8_t(~(1u << (M % 8)));
+        sweep_live[(L / 8) * n_f + f] &= std::uint8_t(~(1u << (L % 8)));
+        sweep_live[(M / 8) * n_f + g] &= std::uint8_t(~(1u << (M % 8)));
         broken_flag[find_bond(sweep_node[L], sweep_box[f])] = 1;
         if (sweep_node[M] < std::int32_t(disc.n_owned()))
           broken_flag[find_bond(sweep_node[M], sweep_box[g])] = 1;

@@ -9,7 +9,11 @@
 //             only near the crack);
 //  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage;
 //  bad_input: ParameterError for bad Hybrid entries;
-//  stretch_budget: the bound of StretchBudget (stretch_budget_test.h).
+//  stretch_budget: the bound of StretchBudget (stretch_budget_test.h);
+//  kw_classes: amortized = every-step test with two bond length classes;
+//  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
+//             source's horizon delta = 2 mm covers the source's 9.72 % of
+//             the plate (Table 3.3), and twice that at delta = 4 mm.
 
 #include <deal.II/base/mpi.h>
 
@@ -253,6 +257,47 @@ namespace
     return m;
   }
 
+  // Amortized (StretchBudget) vs every-step test of (3.80), both run: the
+  // same node switches at the same force evaluation, hence bitwise the same
+  // run; and at most @p max_ratio of the exact node tests are run.
+  void
+  check_same_as_every_step(const MechanicsSolver<2> &hybrid,
+                           const MechanicsSolver<2> &every,
+                           const double              max_ratio)
+  {
+    const auto *hm   = hybrid.hybrid_model();
+    const auto *he   = every.hybrid_model();
+    const auto &disc = hybrid.discretization();
+    std::map<types::particle_index, int> every_switch;
+    for (unsigned int i = 0; i < every.discretization().n_owned(); ++i)
+      every_switch[every.discretization().id[i]] = he->switch_evaluation()[i];
+    unsigned int differ = 0, n_switched = 0;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        differ += hm->switch_evaluation()[i] != every_switch.at(disc.id[i]);
+        n_switched += hm->switch_evaluation()[i] >= 0;
+      }
+    const auto dh = damage_by_id(hybrid), de = damage_by_id(every);
+    double     damage_diff = 0.;
+    for (const auto &[id, d] : dh)
+      damage_diff = std::max(damage_diff, std::abs(d - de.at(id)));
+    check(n_switched > 0 && differ == 0 && hm->n_switch_events() == he->n_switch_events() &&
+            hm->n_overstretched_bonds() == he->n_overstretched_bonds(),
+          "amortized switching test: " + std::to_string(n_switched) +
+            " switched nodes, each at the same force evaluation as with the every-step test (" +
+            std::to_string(differ) + " differ; " + std::to_string(hm->n_switch_events()) + " / " +
+            std::to_string(he->n_switch_events()) + " switch events)");
+    check(damage_diff == 0. &&
+            hybrid.model().n_broken_bonds() == every.model().n_broken_bonds(),
+          "amortized vs every-step: max |damage difference| = " + sci(damage_diff) +
+            ", broken bonds " + std::to_string(hybrid.model().n_broken_bonds()) + " / " +
+            std::to_string(every.model().n_broken_bonds()));
+    // The point of the bound: exact node tests are skipped.
+    check(double(hm->n_exact_node_tests()) < max_ratio * double(he->n_exact_node_tests()),
+          "exact node tests of (3.80): " + std::to_string(hm->n_exact_node_tests()) +
+            " (amortized) vs " + std::to_string(he->n_exact_node_tests()) + " (every step)");
+  }
+
   // (b) KW at CI size: dx = 1 mm, delta = 4 mm (m = 4, 20,000 nodes), to
   // 87.5 us, the same time step for both (0.9 x the hybrid's bound, which
   // is the smaller one). Serial.
@@ -283,38 +328,8 @@ namespace
     standard.run();
     const auto mh = hybrid.measure(), ms = standard.measure();
     const auto dh = damage_by_id(hybrid), ds = damage_by_id(standard);
-
-    // Amortized (StretchBudget) vs every-step test: the same node switches
-    // at the same force evaluation, hence bitwise the same run.
-    const auto *he = every.hybrid_model();
-    std::map<types::particle_index, int> every_switch;
-    for (unsigned int i = 0; i < every.discretization().n_owned(); ++i)
-      every_switch[every.discretization().id[i]] = he->switch_evaluation()[i];
-    unsigned int differ = 0, n_switched = 0;
-    for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      {
-        differ += hm->switch_evaluation()[i] != every_switch.at(disc.id[i]);
-        n_switched += hm->switch_evaluation()[i] >= 0;
-      }
-    const auto de        = damage_by_id(every);
-    double     damage_diff = 0.;
-    for (const auto &[id, d] : dh)
-      damage_diff = std::max(damage_diff, std::abs(d - de.at(id)));
-    check(n_switched > 0 && differ == 0 && hm->n_switch_events() == he->n_switch_events() &&
-            hm->n_overstretched_bonds() == he->n_overstretched_bonds(),
-          "amortized switching test: " + std::to_string(n_switched) +
-            " switched nodes, each at the same force evaluation as with the every-step test (" +
-            std::to_string(differ) + " differ; " + std::to_string(hm->n_switch_events()) + " / " +
-            std::to_string(he->n_switch_events()) + " switch events)");
-    check(damage_diff == 0. &&
-            hybrid.model().n_broken_bonds() == every.model().n_broken_bonds(),
-          "amortized vs every-step: max |damage difference| = " + sci(damage_diff) +
-            ", broken bonds " + std::to_string(hybrid.model().n_broken_bonds()) + " / " +
-            std::to_string(every.model().n_broken_bonds()));
-    // The point of the bound: most exact node tests are skipped.
-    check(hm->n_exact_node_tests() < he->n_exact_node_tests() / 4,
-          "exact node tests of (3.80): " + std::to_string(hm->n_exact_node_tests()) +
-            " (amortized) vs " + std::to_string(he->n_exact_node_tests()) + " (every step)");
+    // Most exact node tests skipped (measured: 22 % of the every-step count).
+    check_same_as_every_step(hybrid, every, 0.25);
     if (root())
       std::cout << "  KW dx = 1, m = 4, " << disc.n_global() << " nodes, "
                 << hybrid.integrator().step() << " steps: Omega_s " << 100. * initial_fraction
@@ -493,6 +508,64 @@ namespace
     p = kalthoff_winkler(4., 8., 1e-6, "hybrid adaptive", 0.9, "bad");
     expect([&] { solver(p); }, "collocation");
   }
+
+  // (e) Two bond length classes (m = 6.4 > 4: bonds up to 4 dx and longer
+  // ones), which test only the bonds of the class whose bound fired: the
+  // same run as the every-step test, and fewer bond tests than whole rows.
+  void
+  kw_classes()
+  {
+    const double dx = 1.25, delta = 8., T = 87.5e-6;
+    auto         ph = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-classes");
+    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph);
+    auto               pe     = ph;
+    pe.hybrid.switching_bound = false;
+    pe.output_directory       = "kw-classes-every-step";
+    MechanicsSolver<2> every(MPI_COMM_SELF, pe);
+    hybrid.run();
+    every.run();
+    // At this coarse lattice (8 x 16 blocks of the long class over the
+    // plate) the wave fronts cover a larger part of the blocks: measured
+    // 0.39. The equivalence is the point here.
+    check_same_as_every_step(hybrid, every, 0.5);
+    const auto  *hm      = hybrid.hybrid_model();
+    const auto  &nb      = hybrid.discretization().neighborhood;
+    const double stencil = double(nb.stencil_size);
+    // (The portable row loop, without AVX-512, tests whole rows.)
+    if (hm->uses_lattice_sweep())
+      check(hm->n_exact_bond_tests() < 0.9 * stencil * double(hm->n_exact_node_tests()),
+            "bond tests per exact node test: " +
+              std::to_string(double(hm->n_exact_bond_tests()) / double(hm->n_exact_node_tests())) +
+              " of a stencil of " + std::to_string(nb.stencil_size) + " (classes tested apart)");
+  }
+
+  // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
+  // horizon of the boundary or two of a pre-crack). Its area is a band
+  // whose width is proportional to delta, so the fraction depends on delta,
+  // not on dx: at the source's delta = 2 mm (Sect. 3.3.1, m = 8 at
+  // dx = 0.25) it is the 9.72 % of Table 3.3; at delta = 4 mm (the CI and
+  // the dx = 0.5 benchmark) about twice that. dx = 0.5, m = 4 for delta = 2
+  // (setup only, no steps), dx = 1, m = 4 for delta = 4.
+  void
+  initial_fraction()
+  {
+    const auto fraction = [](const double dx, const double delta) {
+      MechanicsSolver<2> s(MPI_COMM_WORLD,
+                           kalthoff_winkler(dx, delta, 1e-6, "hybrid adaptive", 0.95, "kw-initial"));
+      s.setup();
+      return s.hybrid_model()->standard_fraction();
+    };
+    const double f2 = fraction(0.5, 2.), f4 = fraction(1., 4.);
+    // 0.5 percentage points: the source's lattice is vertex-centred
+    // (401 x 801 nodes) and it does not print its band widths; the same
+    // bands on its vertex lattice cover 9.87 % (counted separately).
+    check_close(100. * f2, 9.72, 0., "initial Omega_s [%] at delta = 2 mm vs Table 3.3", 0.5);
+    // Pre-crack tips and corners make the band area slightly sub-linear
+    // in delta: 1.8-2.1.
+    check(f4 / f2 > 1.8 && f4 / f2 < 2.1,
+          "initial Omega_s at delta = 4 mm: " + std::to_string(100. * f4) + " %, " +
+            std::to_string(f4 / f2) + " x that at delta = 2 mm");
+  }
 } // namespace
 
 int
@@ -504,5 +577,7 @@ main(int argc, char **argv)
               {"rank_invariance", rank_invariance},
               {"bad_input", bad_input},
               {"sweep", sweep},
+              {"initial_fraction", initial_fraction},
+              {"kw_classes", kw_classes},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

@@ -87,9 +87,10 @@ namespace PeriDEAL
    * subtracted from the slack against round-off of positions and bounds.
    * The bound of a StretchBudget grows with its reach (the width of the
    * blocks), the slack with the shortest bond; so the bonds are split into
-   * length classes (r_min 2^k, r_min 2^(k+1)] (up to four), each with its
+   * length classes (r_min 4^k, r_min 4^(k+1)] (up to two), each with its
    * own StretchBudget (reach: the class's longest bond) and slack (its
-   * shortest bond), and a node is tested when one class's bound fires.
+   * shortest bond); a node tests (and records) the bonds of each class whose
+   * bound fired, the argument above holding per class.
    * Switching is rank independent: each rank marks the owned end points of
    * its critical bonds (a bond to a ghost is tested on both ranks with
    * bitwise the same length), one global sum tells whether anything is
@@ -252,6 +253,16 @@ namespace PeriDEAL
       return exact_node_tests;
     }
     /**
+     * Number of bond tests of the exact node tests so far on this rank
+     * (lattice sweep: a node tests only the bonds of the length classes
+     * whose bound fired).
+     */
+    std::uint64_t
+    n_exact_bond_tests() const
+    {
+      return exact_bond_tests;
+    }
+    /**
      * True if the rows run as lattice sweeps (AVX-512, dim > 1, lattice
      * indices of all local nodes, bond stiffness and length uniform per
      * lattice offset); else the portable row loops over the CSR lists.
@@ -372,7 +383,7 @@ namespace PeriDEAL
     /** Per bond table entry: (r (1 + sigma s0))^2, (r (1 + s0))^2, 1 / (r (1 + sigma s0))^2. */
     std::vector<double> critical_length2, breaking_length2, inverse_critical_length2;
     /**
-     * Bonds in length classes (r_min 2^k, r_min 2^(k+1)] (the last one
+     * Bonds in length classes (r_min 4^k, r_min 4^(k+1)] (the last one
      * open), each with its growth bound of the Omega_w nodes' bond lengths
      * since their last exact test, the upper length bound of the class and
      * min r (1 + sigma s0) over it.
@@ -382,7 +393,7 @@ namespace PeriDEAL
     /** Round-off margin subtracted from every slack. */
     double threshold_margin = 0.;
     std::vector<int> switched_at;
-    std::uint64_t    exact_node_tests = 0;
+    std::uint64_t    exact_node_tests = 0, exact_bond_tests = 0;
     /** Broken flags of the owned rows (op's copy is updated when a bond breaks). */
     std::vector<std::uint8_t> broken_flag;
     mutable bool              op_stale = false;
@@ -410,15 +421,24 @@ namespace PeriDEAL
     std::vector<int>           sweep_of_box;
     std::vector<double>        sweep_k, sweep_r, sweep_L2, sweep_iL2, sweep_B2;
     std::vector<std::uint8_t>  sweep_class;
+    /** Per length class: its full offsets. */
+    std::vector<std::vector<unsigned int>> class_offsets;
     /** Box position of each local node; node (or -1) of each box position. */
     std::vector<std::uint32_t> sweep_position;
     std::vector<std::int32_t>  sweep_node;
-    /** Bit (f, L): bond (L, L + o_f) of an owned row exists and is unbroken. */
+    /**
+     * Bit (f, L): bond (L, L + o_f) of an owned row exists and is unbroken,
+     * at byte (L / 8) n_f + f (the offsets of a vector contiguous: the rows
+     * and the test read all of them per vector).
+     */
     std::vector<std::uint8_t>  sweep_live;
     bool                       sweep_live_valid = false;
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
-    /** Per vector: lanes of owned Omega_s nodes, of shared-pattern WLS rows, to be tested. */
+    /**
+     * Per vector: lanes of owned Omega_s nodes, of shared-pattern WLS rows,
+     * of Omega_w rows; the length classes to test (bit k).
+     */
     std::vector<std::uint8_t>  standard_lanes, shared_lanes, wls_lanes, test_lanes;
     std::vector<std::uint32_t> standard_vectors, shared_vectors, test_vectors;
     /** Bonds broken by the sweep: (full offset, box position of the row). */
