@@ -711,8 +711,8 @@ namespace PeriDEAL
     /**
      * pmb_row() with AVX-512, eight bonds per iteration and a masked tail,
      * one accumulator per component reduced once per row. Every bond goes
-     * through the same instructions (1/l from vrsqrt14pd and Newton steps,
-     * a few ulp from 1/sqrt; l - r by one explicit fused multiply-subtract),
+     * through the same instructions (pmb_bond_scale: 1/l from vrsqrt14pd
+     * and one fourth-order refinement, a few ulp from 1/sqrt),
      * so the two copies of a bond, and the half-list and ghost-list
      * evaluations of a bond on different ranks, see bitwise the same l and
      * break together.

@@ -22,39 +22,58 @@ namespace PeriDEAL
     namespace LatticeSweep
     {
       /**
-       * The PMB bond of eight lanes given l2 = |y|^2, the lengths rb and the
-       * stiffnesses kb: sets brk to the alive lanes with l - r > s0 r (2.34)
-       * and returns k (l - r) / l for the alive, unbroken lanes (0 for the
-       * others). 1/l by vrsqrt14pd (relative error < 2^-14) and two Newton
-       * steps inv <- inv (3/2 - l2/2 inv^2) (error ~1e-16): the divider is
-       * the bottleneck of sqrt + div (doc/benchmarks.md); l - r by one
-       * explicit fused multiply-subtract. Every PMB loop (full list, half
-       * list, ghost list, lattice sweeps) calls this, so all of them see
-       * bitwise the same stretch of a bond and break it together. @p s0r is
-       * s0 r (the sweep passes it precomputed per offset: the same product).
-       * The unbroken lanes come from a second comparison rather than
-       * alive & ~brk, which would round-trip the mask through a general
-       * register on the critical path.
+       * The PMB bond of eight lanes given l2 = |y|^2, the stiffnesses kb,
+       * kr = kb rb (rb the lengths) and t2 = (rb + s0 rb)^2: sets brk to the
+       * alive lanes with l > (1 + s0) r, i.e. l2 > t2 (2.34), and returns
+       * k (l - r) / l = k - kr / l for the alive, unbroken lanes (0 for the
+       * others). The breaking test needs no square root, so it is off the
+       * critical path; the force is one fused k - kr inv after the inverse
+       * length. 1/l: vrsqrt14pd (relative error e0 < 2^-14) and one
+       * fourth-order step inv (1 + e/2 + 3e^2/8 + 5e^3/16), e = 1 - l2 inv^2
+       * (truncation 35/128 e^4 < 1e-16; measured max relative error 1.6e-16
+       * over 1.6e7 random l2, the two Newton steps it replaces 2.7e-16):
+       * the divider is the bottleneck of sqrt + div (doc/benchmarks.md).
+       * Every PMB loop (full list, half list, ghost list, lattice sweeps)
+       * calls this, so all of them see bitwise the same stretch of a bond
+       * and break it together. The unbroken lanes come from a second
+       * comparison rather than alive & ~brk, which would round-trip the
+       * mask through a general register on the critical path.
        */
       inline __m512d
-      pmb_bond_scale(__m512d        l2,
+      pmb_bond_scale_kr(__m512d        l2,
+                        const __mmask8 alive,
+                        const __m512d  kb,
+                        const __m512d  kr,
+                        const __m512d  t2,
+                        __mmask8      &brk)
+      {
+        brk                 = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_GT_OQ);
+        const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_LE_OQ);
+        // Masked-off and broken lanes get l2 = 1 to keep inv finite.
+        l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
+        const __m512d y = _mm512_rsqrt14_pd(l2);
+        const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(l2, y), y, _mm512_set1_pd(1.));
+        __m512d       c = _mm512_fmadd_pd(e, _mm512_set1_pd(5. / 16.), _mm512_set1_pd(3. / 8.));
+        c               = _mm512_fmadd_pd(c, e, _mm512_set1_pd(0.5));
+        const __m512d inv = _mm512_fmadd_pd(_mm512_mul_pd(y, e), c, y);
+        return _mm512_maskz_fnmadd_pd(keep, kr, inv, kb);
+      }
+
+      /**
+       * pmb_bond_scale_kr() given the lengths rb and s0r = s0 rb instead of
+       * kr and t2 (computed here by the same operations as the sweep's
+       * per-offset constants, so the results are bitwise the same).
+       */
+      inline __m512d
+      pmb_bond_scale(const __m512d  l2,
                      const __mmask8 alive,
                      const __m512d  rb,
                      const __m512d  kb,
                      const __m512d  s0r,
                      __mmask8      &brk)
       {
-        // Masked-off and broken lanes get l2 = 1 to keep inv finite.
-        l2                = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-        const __m512d h   = _mm512_mul_pd(_mm512_set1_pd(0.5), l2);
-        __m512d       inv = _mm512_rsqrt14_pd(l2);
-        for (unsigned int it = 0; it < 2; ++it)
-          inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(h, _mm512_mul_pd(inv, inv),
-                                                    _mm512_set1_pd(1.5)));
-        const __m512d  dl   = _mm512_fmsub_pd(l2, inv, rb);
-        const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_LE_OQ);
-        brk                 = _mm512_mask_cmp_pd_mask(alive, dl, s0r, _CMP_GT_OQ);
-        return _mm512_maskz_mul_pd(keep, _mm512_mul_pd(kb, dl), inv);
+        const __m512d t = _mm512_add_pd(rb, s0r);
+        return pmb_bond_scale_kr(l2, alive, kb, _mm512_mul_pd(kb, rb), _mm512_mul_pd(t, t), brk);
       }
 
       /**
@@ -74,8 +93,11 @@ namespace PeriDEAL
        * per offset. Newly broken bonds clear their bit and are appended to
        * @p broken (a vector of pairs) as (h, L).
        */
+      // Not inlined: inlined into the caller's chunk loop, GCC spilled the
+      // stream pointers and masks (the same code ran 10 % slower, CPU time
+      // of pmb_benchmark --chunks, doc/benchmarks.md session 7).
       template <int dim, int NO, typename Broken>
-      inline void
+      __attribute__((noinline)) void
       sweep_offsets(const double        *p,
                     double              *reaction,
                     double              *acc,
@@ -94,75 +116,80 @@ namespace PeriDEAL
                     Broken              &broken)
       {
         using Position = typename Broken::value_type::second_type;
-        // Everything loop-invariant in locals (pointers per offset and
-        // component, s0 r per offset), so that nothing is reloaded per vector.
-        std::uint8_t *bits[NO];
-        __m512d       vk[NO], vr[NO], vs0r[NO];
-        const double *pj[NO][dim];
-        double       *rj[NO][dim];
-        const double *pi_[dim];
-        double       *ai[dim];
+        // One base pointer per component and stream (p_L, reaction, acc,
+        // bits) and the offsets as indices: 4 offsets x 3 components of
+        // precomputed p_{L+o} and reaction pointers did not fit the general
+        // registers, and their spills cost 6-7 % (doc/benchmarks.md,
+        // session 7). The empty asm keeps GCC from hoisting base + offset
+        // out of the loop again. Per offset: k, k r and (r + s0 r)^2.
+        std::uint8_t *const B = live + c0 / 8;
+        std::size_t         bq[NO];
+        std::int64_t        oq[NO];
+        __m512d             vk[NO], vkr[NO], vt2[NO];
+        const double       *P[dim];
+        double             *Rb[dim], *A[dim];
         for (unsigned int d = 0; d < dim; ++d)
           {
-            pi_[d] = p + d * N + c0;
-            ai[d]  = acc + d * C;
+            P[d]  = p + d * N + c0;
+            Rb[d] = reaction + d * N + c0;
+            A[d]  = acc + d * C;
           }
         for (int q = 0; q < NO; ++q)
           {
-            bits[q] = live + hs[q] * n_bytes + c0 / 8;
-            vk[q]   = _mm512_set1_pd(k[hs[q]]);
-            vr[q]   = _mm512_set1_pd(r[hs[q]]);
-            vs0r[q] = _mm512_mul_pd(_mm512_set1_pd(s0), vr[q]);
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                pj[q][d] = pi_[d] + o[hs[q]];
-                rj[q][d] = reaction + d * N + c0 + o[hs[q]];
-              }
+            bq[q]            = hs[q] * n_bytes;
+            oq[q]            = o[hs[q]];
+            const __m512d vr = _mm512_set1_pd(r[hs[q]]);
+            const __m512d t  = _mm512_add_pd(vr, _mm512_mul_pd(_mm512_set1_pd(s0), vr));
+            vk[q]            = _mm512_set1_pd(k[hs[q]]);
+            vkr[q]           = _mm512_mul_pd(vk[q], vr);
+            vt2[q]           = _mm512_mul_pd(t, t);
           }
-        const auto group = [&](const unsigned int v) {
+        const auto group = [&](const std::size_t v) {
           __mmask8 alive[NO], any = 0;
 #  pragma GCC unroll 4
           for (int q = 0; q < NO; ++q)
-            any |= alive[q] = bits[q][v / 8];
+            any |= alive[q] = B[bq[q] + v / 8];
           if (any == 0)
             return;
           __m512d pi[dim], f[dim];
           for (unsigned int d = 0; d < dim; ++d)
             {
-              pi[d] = _mm512_loadu_pd(pi_[d] + v);
-              f[d]  = _mm512_load_pd(ai[d] + v);
+              pi[d] = _mm512_loadu_pd(P[d] + v);
+              f[d]  = _mm512_load_pd(A[d] + v);
             }
-          // Unrolled: the per-offset constants and pointers stay in
-          // registers (a rolled loop reloads them from the stack per vector).
+          // Unrolled: the per-offset constants stay in registers (a rolled
+          // loop reloads them from the stack per vector).
 #  pragma GCC unroll 4
           for (int q = 0; q < NO; ++q)
             {
               if (alive[q] == 0)
                 continue;
+              std::int64_t j = std::int64_t(v) + oq[q];
+              asm("" : "+r"(j));
               __m512d y[dim];
               for (unsigned int d = 0; d < dim; ++d)
-                y[d] = _mm512_sub_pd(_mm512_loadu_pd(pj[q][d] + v), pi[d]);
+                y[d] = _mm512_sub_pd(_mm512_loadu_pd(P[d] + j), pi[d]);
               __m512d l2 = _mm512_mul_pd(y[0], y[0]);
               for (unsigned int d = 1; d < dim; ++d)
                 l2 = _mm512_fmadd_pd(y[d], y[d], l2);
               __mmask8      brk;
-              const __m512d scale = pmb_bond_scale(l2, alive[q], vr[q], vk[q], vs0r[q], brk);
+              const __m512d scale = pmb_bond_scale_kr(l2, alive[q], vk[q], vkr[q], vt2[q], brk);
               for (unsigned int d = 0; d < dim; ++d)
                 {
-                  double *rd = rj[q][d] + v;
+                  double *rd = Rb[d] + j;
                   f[d]       = _mm512_fmadd_pd(scale, y[d], f[d]);
                   _mm512_storeu_pd(rd, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(rd)));
                 }
               if (__builtin_expect(brk != 0, 0))
                 {
-                  bits[q][v / 8] = alive[q] & ~brk;
+                  B[bq[q] + v / 8] = alive[q] & ~brk;
                   for (unsigned int l = 0; l < 8; ++l)
                     if ((brk >> l) & 1u)
                       broken.emplace_back(hs[q], Position(c0 + v + l));
                 }
             }
           for (unsigned int d = 0; d < dim; ++d)
-            _mm512_store_pd(ai[d] + v, f[d]);
+            _mm512_store_pd(A[d] + v, f[d]);
         };
         if (groups != nullptr)
           for (unsigned int g = 0; g < n_groups; ++g)
