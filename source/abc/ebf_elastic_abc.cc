@@ -393,6 +393,30 @@ namespace PeriDEAL
                 normals.push_back(all_normals[c]);
               }
         }
+      // The sponge (as PdUnboundedWave: sigma_max min(1, (s_in - s)/w)^p at
+      // depth s; inside an overwritten or fixed layer, s_in = layer + w).
+      damping.assign(disc.n_owned(), d);
+      if (truncation != ElasticTruncation::free && prm.sponge_damping > 0.)
+        {
+          const double w = prm.sponge_thickness;
+          check_parameter(w >= lattice.dx * (1. - 1e-12), "Absorbing boundary/Sponge thickness", w,
+                          ">= dx when Sponge damping > 0");
+          const double s_in =
+            w + (truncation == ElasticTruncation::sponge ? 0. :
+                                                           (prm.layer_thickness > 0 ? prm.layer_thickness : lattice.delta));
+          std::vector<unsigned int> band;
+          std::vector<Tensor<1, 2>> band_normals;
+          find_absorbing_layer(disc, domain, s_in, prm.cloud_radius, band, band_normals);
+          for (unsigned int c = 0; c < band.size(); ++c)
+            if (!keep || keep(disc.position[band[c]], band_normals[c]))
+              {
+                const double s = -domain.signed_distance(disc.position[band[c]]);
+                damping[band[c]] += prm.sponge_damping * std::pow(std::min(1., (s_in - s) / w), prm.sponge_exponent);
+              }
+        }
+      else
+        check_parameter(truncation != ElasticTruncation::sponge, "Absorbing boundary/Sponge damping",
+                        prm.sponge_damping, "> 0 with the sponge truncation");
       n_layer_nodes =
         Utilities::MPI::sum<types::global_dof_index>(nodes.size(), disc.get_mpi_communicator());
       if (truncation == ElasticTruncation::absorbing)
@@ -430,7 +454,7 @@ namespace PeriDEAL
       op->compute_forces(u, f);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         for (unsigned int q = 0; q < 2; ++q)
-          a[q].local_element(i) = f[q].local_element(i) / rho - 2. * d * v[q].local_element(i);
+          a[q].local_element(i) = f[q].local_element(i) / rho - 2. * damping[i] * v[q].local_element(i);
     }
 
     void
@@ -512,15 +536,15 @@ namespace PeriDEAL
       for (unsigned int q = 0; q < 2; ++q)
         u[q].update_ghost_values();
       op->compute_forces(u, f);
-      const double scale = 1. / (1. + dt * d);
       for (unsigned int q = 0; q < 2; ++q)
         {
           double       *vv = v[q].begin(), *aa = a[q].begin();
           const double *ff = f[q].begin();
           for (unsigned int i = 0; i < disc.n_owned(); ++i)
             {
-              vv[i] = scale * (vv[i] + half * ff[i] / rho);
-              aa[i] = ff[i] / rho - 2. * d * vv[i];
+              const double scale = 1. / (1. + dt * damping[i]);
+              vv[i]              = scale * (vv[i] + half * ff[i] / rho);
+              aa[i]              = ff[i] / rho - 2. * damping[i] * vv[i];
             }
         }
       const auto set_start = clock::now();
