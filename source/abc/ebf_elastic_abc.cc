@@ -398,21 +398,15 @@ namespace PeriDEAL
       damping.assign(disc.n_owned(), d);
       if (truncation != ElasticTruncation::free && prm.sponge_damping > 0.)
         {
-          const double w = prm.sponge_thickness;
-          check_parameter(w >= lattice.dx * (1. - 1e-12), "Absorbing boundary/Sponge thickness", w,
-                          ">= dx when Sponge damping > 0");
           const double s_in =
-            w + (truncation == ElasticTruncation::sponge ? 0. :
-                                                           (prm.layer_thickness > 0 ? prm.layer_thickness : lattice.delta));
-          std::vector<unsigned int> band;
-          std::vector<Tensor<1, 2>> band_normals;
-          find_absorbing_layer(disc, domain, s_in, prm.cloud_radius, band, band_normals);
-          for (unsigned int c = 0; c < band.size(); ++c)
-            if (!keep || keep(disc.position[band[c]], band_normals[c]))
-              {
-                const double s = -domain.signed_distance(disc.position[band[c]]);
-                damping[band[c]] += prm.sponge_damping * std::pow(std::min(1., (s_in - s) / w), prm.sponge_exponent);
-              }
+            prm.sponge_thickness +
+            (truncation == ElasticTruncation::sponge ? 0. :
+                                                       (prm.layer_thickness > 0 ? prm.layer_thickness : lattice.delta));
+          const std::vector<double> sigma =
+            sponge_profile<2>(disc, domain, prm.sponge_damping, prm.sponge_thickness, prm.sponge_exponent, s_in,
+                              prm.cloud_radius, keep);
+          for (unsigned int i = 0; i < disc.n_owned(); ++i)
+            damping[i] += sigma[i];
         }
       else
         check_parameter(truncation != ElasticTruncation::sponge, "Absorbing boundary/Sponge damping",

@@ -879,18 +879,15 @@ namespace PeriDEAL
       damping.assign(disc.n_owned(), d);
       if (boundary != WaveTruncation::free && prm_in.sponge_damping > 0.)
         {
-          const double w = prm_in.sponge_thickness;
-          check_parameter(w >= lattice.dx * (1. - 1e-12), "Absorbing boundary/Sponge thickness", w,
-                          ">= dx when Sponge damping > 0");
           const double s_in =
-            w + (absorbing ? (prm_in.layer_thickness > 0 ? prm_in.layer_thickness : lattice.delta) : 0.);
+            prm_in.sponge_thickness +
+            (absorbing ? (prm_in.layer_thickness > 0 ? prm_in.layer_thickness : lattice.delta) : 0.);
+          const std::vector<double> sigma =
+            sponge_profile<dim>(disc, domain, prm_in.sponge_damping, prm_in.sponge_thickness,
+                                prm_in.sponge_exponent, s_in,
+                                prm_in.cloud_radius > 0. ? prm_in.cloud_radius : lattice.delta);
           for (unsigned int i = 0; i < disc.n_owned(); ++i)
-            {
-              const double s = -domain.signed_distance(disc.position[i]);
-              if (s < s_in)
-                damping[i] += prm_in.sponge_damping *
-                              std::pow(std::min(1., (s_in - s) / w), prm_in.sponge_exponent);
-            }
+            damping[i] += sigma[i];
         }
       else
         check_parameter(!sponge_only, "Absorbing boundary/Sponge damping", prm_in.sponge_damping,

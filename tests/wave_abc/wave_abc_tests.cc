@@ -1104,7 +1104,7 @@ namespace
   sponge()
   {
     // (a) Spectral radius of the full one-step map, R = 2.5 (as the EBF
-    // diagnostics): <= 1 to round-off (measured 1 - 5.7e-15, 1 - 3.8e-15; the
+    // diagnostics): <= 1 to round-off (measured 1 - 5.7e-15, 1 + 2.2e-16; the
     // eigenvalue 1 is the constant state).
     WaveAbcParameters prm = sponge_parameters();
     for (const double sigma : {2., 6.})
