@@ -464,13 +464,12 @@ namespace PeriDEAL
         return damping;
       }
       /**
-       * The discrete energy of the damped velocity Verlet scheme at the
-       * half step, E^{n+1/2} = 1/2 |v^{n+1/2}|^2_V + 1/2 |u^{n+1} - u^n|_L^2 ...
-       * written without the absorbing layer: 1/2 sum v_h^2 V +
-       * 1/2 (a(u^n, u^{n+1})) with a(u, w) = 1/2 sum_ij k_ij (u_j - u_i)(w_j - w_i)
-       * V_i V_j and v_h = v^{n+1/2} of the last step (all ranks). Without
-       * an overwritten layer it is non-increasing for any damping
-       * d + sigma >= 0 below the critical step (doc/design.md, session 7).
+       * The discrete energy of the damped velocity Verlet scheme at the last
+       * half step, E^{n+1/2} = 1/2 sum_i (v_i^{n+1/2})^2 V_i + 1/2 a(u^n, u^{n+1})
+       * with a(u, w) = 1/2 sum_ij k_ij (u_j - u_i)(w_j - w_i) beta V_i V_j
+       * (all ranks; needs one advance()). Without an overwritten layer it is
+       * non-increasing for any damping d + sigma >= 0 below the critical
+       * step (doc/design.md, session 7).
        */
       double
       half_step_energy() const;
