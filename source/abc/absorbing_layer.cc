@@ -1,6 +1,8 @@
 #include <perideal/abc/absorbing_layer.h>
 #include <perideal/base/exceptions.h>
 
+#include <cmath>
+
 namespace PeriDEAL
 {
   namespace Abc
@@ -42,10 +44,39 @@ namespace PeriDEAL
         }
     }
 
+    template <int dim>
+    std::vector<double>
+    sponge_profile(const Discretization<dim> &disc,
+                   const Domain<dim>         &domain,
+                   const double               sigma_max,
+                   const double               w,
+                   const double               p,
+                   const double               s_in,
+                   const double               cloud_radius,
+                   const std::function<bool(const Point<dim> &, const Tensor<1, dim> &)> &keep)
+    {
+      check_parameter(w >= disc.parameters().dx * (1. - 1e-12), "Absorbing boundary/Sponge thickness", w,
+                      ">= dx when Sponge damping > 0");
+      std::vector<double>         sigma(disc.n_owned(), 0.);
+      std::vector<unsigned int>   band;
+      std::vector<Tensor<1, dim>> normals;
+      find_absorbing_layer(disc, domain, s_in, cloud_radius, band, normals);
+      for (unsigned int c = 0; c < band.size(); ++c)
+        if (!keep || keep(disc.position[band[c]], normals[c]))
+          {
+            const double s  = -domain.signed_distance(disc.position[band[c]]);
+            sigma[band[c]] = sigma_max * std::pow(std::min(1., (s_in - s) / w), p);
+          }
+      return sigma;
+    }
+
 #define PERIDEAL_INSTANTIATE(dim)                                                              \
   template void find_absorbing_layer<dim>(const Discretization<dim> &, const Domain<dim> &,    \
                                           double, double, std::vector<unsigned int> &,         \
-                                          std::vector<Tensor<1, dim>> &);
+                                          std::vector<Tensor<1, dim>> &);                      \
+  template std::vector<double> sponge_profile<dim>(                                            \
+    const Discretization<dim> &, const Domain<dim> &, double, double, double, double, double,  \
+    const std::function<bool(const Point<dim> &, const Tensor<1, dim> &)> &);
     PERIDEAL_INSTANTIATE(1)
     PERIDEAL_INSTANTIATE(2)
     PERIDEAL_INSTANTIATE(3)

@@ -393,6 +393,24 @@ namespace PeriDEAL
                 normals.push_back(all_normals[c]);
               }
         }
+      // The sponge (as PdUnboundedWave: sigma_max min(1, (s_in - s)/w)^p at
+      // depth s; inside an overwritten or fixed layer, s_in = layer + w).
+      damping.assign(disc.n_owned(), d);
+      if (truncation != ElasticTruncation::free && prm.sponge_damping > 0.)
+        {
+          const double s_in =
+            prm.sponge_thickness +
+            (truncation == ElasticTruncation::sponge ? 0. :
+                                                       (prm.layer_thickness > 0 ? prm.layer_thickness : lattice.delta));
+          const std::vector<double> sigma =
+            sponge_profile<2>(disc, domain, prm.sponge_damping, prm.sponge_thickness, prm.sponge_exponent, s_in,
+                              prm.cloud_radius, keep);
+          for (unsigned int i = 0; i < disc.n_owned(); ++i)
+            damping[i] += sigma[i];
+        }
+      else
+        check_parameter(truncation != ElasticTruncation::sponge, "Absorbing boundary/Sponge damping",
+                        prm.sponge_damping, "> 0 with the sponge truncation");
       n_layer_nodes =
         Utilities::MPI::sum<types::global_dof_index>(nodes.size(), disc.get_mpi_communicator());
       if (truncation == ElasticTruncation::absorbing)
@@ -430,7 +448,7 @@ namespace PeriDEAL
       op->compute_forces(u, f);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         for (unsigned int q = 0; q < 2; ++q)
-          a[q].local_element(i) = f[q].local_element(i) / rho - 2. * d * v[q].local_element(i);
+          a[q].local_element(i) = f[q].local_element(i) / rho - 2. * damping[i] * v[q].local_element(i);
     }
 
     void
@@ -512,15 +530,15 @@ namespace PeriDEAL
       for (unsigned int q = 0; q < 2; ++q)
         u[q].update_ghost_values();
       op->compute_forces(u, f);
-      const double scale = 1. / (1. + dt * d);
       for (unsigned int q = 0; q < 2; ++q)
         {
           double       *vv = v[q].begin(), *aa = a[q].begin();
           const double *ff = f[q].begin();
           for (unsigned int i = 0; i < disc.n_owned(); ++i)
             {
-              vv[i] = scale * (vv[i] + half * ff[i] / rho);
-              aa[i] = ff[i] / rho - 2. * d * vv[i];
+              const double scale = 1. / (1. + dt * damping[i]);
+              vv[i]              = scale * (vv[i] + half * ff[i] / rho);
+              aa[i]              = ff[i] / rho - 2. * damping[i] * vv[i];
             }
         }
       const auto set_start = clock::now();

@@ -89,8 +89,17 @@ namespace PeriDEAL
       prm.declare_entry("Layer filter", "0", Patterns::Double(0., 0.25),
                         "eps of the lattice-Laplacian viscosity added to the updating vectors "
                         "(eps sum over the nearest nodes of (u_j - u_i)^n - (u_j - u_i)^{n-1}; 0: the source).");
-      prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order"),
-                        "The EBF extrapolation (4.82) or the conventional first-order ABC (4.75).");
+      prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge"),
+                        "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), or "
+                        "only the damping sponge (PD: nothing overwritten, energy-stable).");
+      prm.declare_entry("Sponge damping", "0", Patterns::Double(0.),
+                        "PD: largest extra damping rate sigma_max of the sponge, u'' = L u - 2 (d + "
+                        "sigma) u' (0: no sponge).");
+      prm.declare_entry("Sponge thickness", "0", Patterns::Double(0.),
+                        "PD: sponge width w inside the overwritten layer (method sponge: from the "
+                        "boundary); > 0 when the sponge damping is > 0.");
+      prm.declare_entry("Sponge exponent", "2", Patterns::Double(0.),
+                        "PD: p of the profile sigma = sigma_max min(1, (s_in - s)/w)^p over the depth s.");
       prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
                         "Setup throws ParameterError if the checked spectral radius exceeds this.");
     }
@@ -118,6 +127,9 @@ namespace PeriDEAL
       lattice_mode_damping     = prm.get_double("Lattice mode damping");
       layer_filter             = prm.get_double("Layer filter");
       method                   = prm.get("Method");
+      sponge_damping           = prm.get_double("Sponge damping");
+      sponge_thickness         = prm.get_double("Sponge thickness");
+      sponge_exponent          = prm.get_double("Sponge exponent");
     }
 
 
@@ -813,6 +825,8 @@ namespace PeriDEAL
       d  = model.damping;
       t  = 0.;
       spectral_radius = 0.;
+      u_prev.clear();
+      v_half.clear();
       for (Vector *x : {&u, &v, &a, &Lu})
         disc.initialize_vector(*x);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
@@ -856,7 +870,28 @@ namespace PeriDEAL
       u_old.assign(u.begin(), u.begin() + n_local);
       v_old.assign(v.begin(), v.begin() + n_local);
 
-      absorbing = boundary != WaveTruncation::free;
+      const bool sponge_only = boundary == WaveTruncation::sponge ||
+                               (boundary == WaveTruncation::absorbing && prm_in.method == "sponge");
+      absorbing = boundary != WaveTruncation::free && !sponge_only;
+      // The sponge (not for the free truncation, which is the reference):
+      // sigma(s) = sigma_max min(1, (s_in - s)/w)^p at depth s, s_in = the
+      // overwritten layer (if any) plus w.
+      damping.assign(disc.n_owned(), d);
+      if (boundary != WaveTruncation::free && prm_in.sponge_damping > 0.)
+        {
+          const double s_in =
+            prm_in.sponge_thickness +
+            (absorbing ? (prm_in.layer_thickness > 0 ? prm_in.layer_thickness : lattice.delta) : 0.);
+          const std::vector<double> sigma =
+            sponge_profile<dim>(disc, domain, prm_in.sponge_damping, prm_in.sponge_thickness,
+                                prm_in.sponge_exponent, s_in,
+                                prm_in.cloud_radius > 0. ? prm_in.cloud_radius : lattice.delta);
+          for (unsigned int i = 0; i < disc.n_owned(); ++i)
+            damping[i] += sigma[i];
+        }
+      else
+        check_parameter(!sponge_only, "Absorbing boundary/Sponge damping", prm_in.sponge_damping,
+                        "> 0 with method sponge");
       if (prm_in.dispersion == "local")
         relation = std::make_unique<WaveDispersion<dim>>(
           WaveDispersion<dim>::local(model.wave_speed, d));
@@ -937,22 +972,27 @@ namespace PeriDEAL
         }
       const auto abc_end = clock::now();
       double    *uu = u.begin(), *vv = v.begin(), *aa = a.begin();
+      u_prev.assign(uu, uu + disc.n_owned() + disc.n_ghost());
+      v_half.resize(disc.n_owned());
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         {
           uu[i] += dt * (vv[i] + half * aa[i]);
           vv[i] += half * aa[i];
+          v_half[i] = vv[i];
         }
       for (unsigned int c = 0; c < nodes.size(); ++c)
         uu[nodes[c]] = u_abc[c];
       t += dt;
       u.update_ghost_values();
       apply_operator();
-      const double  scale = 1. / (1. + dt * d);
-      const double *lu    = Lu.begin();
+      // Trapezoidal damping: v^{n+1/2} - v^{n-1/2} = dt L u^n - dt D (v^{n+1/2}
+      // + v^{n-1/2}), so the half-step energy decays for any D >= 0.
+      const double *lu = Lu.begin();
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         {
-          vv[i] = scale * (vv[i] + half * lu[i]);
-          aa[i] = lu[i] - 2. * d * vv[i];
+          const double scale = 1. / (1. + dt * damping[i]);
+          vv[i]              = scale * (vv[i] + half * lu[i]);
+          aa[i] = lu[i] - 2. * damping[i] * vv[i];
         }
       const auto set_start = clock::now();
       for (unsigned int c = 0; c < nodes.size(); ++c)
@@ -979,7 +1019,7 @@ namespace PeriDEAL
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
       // Save the solver state.
       const Vector              u0 = u, v0 = v, a0 = a;
-      const std::vector<double> uo0 = u_old, vo0 = v_old;
+      const std::vector<double> uo0 = u_old, vo0 = v_old, up0 = u_prev, vh0 = v_half;
       const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
       const auto                set_state = [&](const std::vector<double> &x) {
         for (unsigned int i = 0; i < n; ++i)
@@ -999,7 +1039,7 @@ namespace PeriDEAL
         // v is not overwritten by the absorbing update).
         apply_operator();
         for (unsigned int i = 0; i < n; ++i)
-          a.local_element(i) = Lu.local_element(i) - 2. * d * v.local_element(i);
+          a.local_element(i) = Lu.local_element(i) - 2. * damping[i] * v.local_element(i);
       };
       map.assign(std::size_t(m) * m, 0.);
       std::vector<double> x(m);
@@ -1025,8 +1065,10 @@ namespace PeriDEAL
       u     = u0;
       v     = v0;
       a     = a0;
-      u_old = uo0;
-      v_old = vo0;
+      u_old  = uo0;
+      v_old  = vo0;
+      u_prev = up0;
+      v_half = vh0;
       u.update_ghost_values();
       v.update_ghost_values();
       t            = t0;
@@ -1178,6 +1220,30 @@ namespace PeriDEAL
       for (const auto &[i, j, w] : broken)
         if (inside(disc.position[i]))
           e -= 0.25 * w * (uu[j] - uu[i]) * (uu[j] - uu[i]) * disc.volume[i];
+      return Utilities::MPI::sum(e, disc.get_mpi_communicator());
+    }
+
+    template <int dim>
+    double
+    PdUnboundedWave<dim>::half_step_energy() const
+    {
+      AssertThrow(!u_prev.empty(), ExcMessage("half_step_energy() needs one advance()"));
+      const auto   &nb = disc.neighborhood;
+      const double *uu = u.begin();
+      double        e  = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        {
+          const double *w   = bond_kernel_weight.data() + nb.table_start[i];
+          double        row = 0.;
+          for (std::uint64_t q = nb.row_start[i]; q < nb.row_start[i + 1]; ++q)
+            {
+              const unsigned int j = nb.col[q];
+              row += w[q - nb.row_start[i]] * (uu[j] - uu[i]) * (u_prev[j] - u_prev[i]);
+            }
+          e += (0.5 * v_half[i] * v_half[i] + 0.25 * row) * disc.volume[i];
+        }
+      for (const auto &[i, j, w] : broken)
+        e -= 0.25 * w * (uu[j] - uu[i]) * (u_prev[j] - u_prev[i]) * disc.volume[i];
       return Utilities::MPI::sum(e, disc.get_mpi_communicator());
     }
 

@@ -1,6 +1,6 @@
 perideal_add_test_program(elastic_abc_tests ${CMAKE_CURRENT_LIST_DIR}/elastic_abc_tests.cc)
 
-foreach(_t dispersion guards)
+foreach(_t dispersion guards sponge)
   perideal_add_test(NAME elastic_abc.${_t} COMMAND $<TARGET_FILE:elastic_abc_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME elastic_abc.unbounded COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded

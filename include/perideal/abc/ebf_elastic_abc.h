@@ -160,7 +160,14 @@ namespace PeriDEAL
       /** A free PD surface (traction-free, reflecting). Also the extended reference. */
       free,
       /** The layer nodes held at u = v = 0 (reflecting). */
-      fixed
+      fixed,
+      /**
+       * Only the damping sponge of WaveAbcParameters ("Sponge damping",
+       * "Sponge thickness", "Sponge exponent"): nothing overwritten, the
+       * damping d + sigma(x) >= 0 per node (energy-stable, doc/design.md
+       * session 7). The @p keep filter of setup() exempts nodes as for the layer.
+       */
+      sponge
     };
 
     /** Density, time step and damping of an elastic wave run. */
@@ -289,6 +296,8 @@ namespace PeriDEAL
       std::vector<unsigned int> held_nodes;
       std::function<Tensor<1, 2>(const Point<2> &, double)> held_velocity;
       double rho = 1., dt = 0., t = 0., d = 0.;
+      /** d + sigma(x_i) per owned node (the sponge; d without one). */
+      std::vector<double> damping;
       ElasticTruncation truncation = ElasticTruncation::free;
 
       void

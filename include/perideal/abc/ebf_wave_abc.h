@@ -112,6 +112,22 @@ namespace PeriDEAL
        * speed of the dispersion relation.
        */
       std::string method = "ebf";
+      /**
+       * PD: largest extra damping rate sigma_max of the sponge (0: none).
+       * The nodes at depth s (distance to the truncation boundary) below
+       * s_in = (overwritten layer ? delta_L : 0) + w get the extra damping
+       * sigma(s) = sigma_max min(1, (s_in - s)/w)^p in
+       * u'' = L u - 2 (d + sigma) u' (w: "Sponge thickness", p: "Sponge
+       * exponent"). With method "sponge" nothing is overwritten and the
+       * semi-discrete and the discrete (velocity Verlet) energies are
+       * non-increasing (doc/design.md, session 7); with "ebf" or "first
+       * order" the sponge lies inside the overwritten layer.
+       */
+      double sponge_damping = 0.;
+      /** Sponge width w (> 0 when sponge_damping > 0). */
+      double sponge_thickness = 0.;
+      /** Exponent p of the sponge profile. */
+      double sponge_exponent = 2.;
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -326,7 +342,13 @@ namespace PeriDEAL
        * least-squares linear fit over the cone behind the node (the
        * baseline of Sect. 4.2.5).
        */
-      first_order
+      first_order,
+      /**
+       * Only the damping sponge of WaveAbcParameters (method "sponge"):
+       * nothing is overwritten, the free PD near field is damped near its
+       * boundary; energy-stable by construction.
+       */
+      sponge
     };
 
     /**
@@ -435,6 +457,22 @@ namespace PeriDEAL
       double abc_seconds = 0., step_seconds = 0.;
       /** One-step spectral radius computed by setup (0 if not checked). */
       double spectral_radius = 0.;
+      /** Total damping rate d + sigma(x_i) of each owned node (the sponge). */
+      const std::vector<double> &
+      damping_rates() const
+      {
+        return damping;
+      }
+      /**
+       * The discrete energy of the damped velocity Verlet scheme at the last
+       * half step, E^{n+1/2} = 1/2 sum_i (v_i^{n+1/2})^2 V_i + 1/2 a(u^n, u^{n+1})
+       * with a(u, w) = 1/2 sum_ij k_ij (u_j - u_i)(w_j - w_i) beta V_i V_j
+       * (all ranks; needs one advance()). Without an overwritten layer it is
+       * non-increasing for any damping d + sigma >= 0 below the critical
+       * step (doc/design.md, session 7).
+       */
+      double
+      half_step_energy() const;
 
     private:
       /** The dense one-step map (column-major, m x m) of one_step_spectral_radius(). */
@@ -451,6 +489,8 @@ namespace PeriDEAL
       Vector                                  u, v, a, Lu;
       std::vector<double>                     u_old, v_old, u_abc, v_abc;
       std::vector<double>                     bond_kernel_weight;
+      /** d + sigma(x_i) per owned node; v^{n-1/2} and u^{n-1} of the last step. */
+      std::vector<double>                     damping, v_half, u_prev;
       /** Broken bonds: owned row i, local column j, kernel weight. */
       std::vector<std::tuple<unsigned int, unsigned int, double>> broken;
       double                                  dt = 0., t = 0., d = 0.;
