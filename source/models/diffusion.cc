@@ -39,31 +39,6 @@ namespace PeriDEAL
       return (s0 + s1) + (s2 + s3);
     }
 
-    // sum_k w_k kappa (c[ci[k]] - c_i) of a one-kappa row: four independent
-    // chains as above (the summation order differs from the per-bond loop
-    // only at round-off; the differences keep the cancellation-free form).
-    PERIDEAL_SCALAR_LOOP inline double
-    difference_row_sum(const std::int32_t *ci,
-                       const double       *wi,
-                       const unsigned int  m,
-                       const double       *c,
-                       const double        c_i,
-                       const double        kappa)
-    {
-      double       s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
-      unsigned int k  = 0;
-      for (; k + 4 <= m; k += 4)
-        {
-          s0 += wi[k] * kappa * (c[ci[k]] - c_i);
-          s1 += wi[k + 1] * kappa * (c[ci[k + 1]] - c_i);
-          s2 += wi[k + 2] * kappa * (c[ci[k + 2]] - c_i);
-          s3 += wi[k + 3] * kappa * (c[ci[k + 3]] - c_i);
-        }
-      for (; k < m; ++k)
-        s0 += wi[k] * kappa * (c[ci[k]] - c_i);
-      return (s0 + s1) + (s2 + s3);
-    }
-
     // Long rows (3D, large m): the vectorized gather loop wins.
     inline double
     weighted_row_sum_long(const std::int32_t *ci,
@@ -309,12 +284,24 @@ namespace PeriDEAL
     auto row_value = [&](const unsigned int i) {
       const int uniform = classify ? solid_count.uniform_phase(i) : -1;
       if (uniform < 0)
-        return standard_row(i);
+        {
+          if (!classify)
+            return standard_row(i);
+          // both phases: kappa per bond from the neighbour's phase flag (a
+          // byte gather), the products of standard_row() in four chains
+          const double        *kappa = kappa_table.data() + (ph[i] > 0.5 ? 2 : 0);
+          const unsigned char *solid = solid_count.solid_flags();
+          return PeriDEAL::internal::phase_row_sum(col + row_start[i], gw + table[i],
+                                         row_start[i + 1] - row_start[i], c, c[i],
+                                         [&](const std::int32_t j) { return kappa[solid[j]]; });
+        }
       const double kappa = bond_kappa(ph[i] > 0.5, uniform == 1);
       if (kappa == 0.)
         return 0.;
-      return difference_row_sum(col + row_start[i], gw + table[i],
-                                row_start[i + 1] - row_start[i], c, c[i], kappa);
+      // one kappa: four chains (round-off differences from the per-bond loop)
+      return PeriDEAL::internal::phase_row_sum(col + row_start[i], gw + table[i],
+                                     row_start[i + 1] - row_start[i], c, c[i],
+                                     [kappa](std::int32_t) { return kappa; });
     };
     for_standard_rows([&](const unsigned int i) { r[i] = row_value(i); });
     if (wls)

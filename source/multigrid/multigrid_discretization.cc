@@ -719,23 +719,25 @@ namespace PeriDEAL
                 prm.corrosion ? kappa_table[2 * (phase[i] > 0.5) + uniform] : prm.kappa;
               if (kappa == 0.)
                 continue;
-              // four independent chains (latency-bound otherwise)
-              const double        v_i = v[i];
-              const double       *kw  = kernel_weight.data();
-              const unsigned int *cj  = disc.col.data();
-              double              s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
-              unsigned int        b = disc.row_start[i];
-              const unsigned int  e = disc.row_start[i + 1];
-              for (; b + 4 <= e; b += 4)
-                {
-                  s0 += kappa * kw[b] * (v[cj[b]] - v_i);
-                  s1 += kappa * kw[b + 1] * (v[cj[b + 1]] - v_i);
-                  s2 += kappa * kw[b + 2] * (v[cj[b + 2]] - v_i);
-                  s3 += kappa * kw[b + 3] * (v[cj[b + 3]] - v_i);
-                }
-              for (; b < e; ++b)
-                s0 += kappa * kw[b] * (v[cj[b]] - v_i);
-              out[i] += (s0 + s1) + (s2 + s3);
+              const unsigned int b = disc.row_start[i];
+              out[i] += PeriDEAL::internal::phase_row_sum(disc.col.data() + b, kernel_weight.data() + b,
+                                                disc.row_start[i + 1] - b, v.data(), v[i],
+                                                [kappa](unsigned int) { return kappa; });
+              continue;
+            }
+          if (fast && prm.corrosion)
+            {
+              // corrosion, a row of both phases: kappa per bond from the
+              // neighbour's phase flag (a byte gather), the products of
+              // bond_kappa() below in four chains (equal up to round-off)
+              const double        *kappa = kappa_table + 2 * (phase[i] > 0.5);
+              const unsigned char *solid = solid_count.solid_flags();
+              const unsigned int   b     = disc.row_start[i];
+              out[i] += PeriDEAL::internal::phase_row_sum(disc.col.data() + b, kernel_weight.data() + b,
+                                                disc.row_start[i + 1] - b, v.data(), v[i],
+                                                [&](const unsigned int j) {
+                                                  return kappa[solid[j]];
+                                                });
               continue;
             }
           const bool skip_fictitious = prm.conservative && disc.grid[i] == disc.coarse;

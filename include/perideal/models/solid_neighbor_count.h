@@ -93,12 +93,59 @@ namespace PeriDEAL
       return count[r] == 0 ? 0 : (count[r] == size[r] ? 1 : -1);
     }
 
+    /**
+     * The phase flags of the last initialize()/update() (1 solid, 0 liquid),
+     * one per column node: a byte gather for the per-bond kernels of the
+     * mixed rows instead of a comparison of the phase field's doubles.
+     */
+    const unsigned char *
+    solid_flags() const
+    {
+      return flag.data();
+    }
+
   private:
     std::vector<unsigned char> flag;
     std::vector<unsigned int>  count, size;
     std::vector<std::uint64_t> t_start;
     std::vector<unsigned int>  t_row;
   };
+
+  namespace internal
+  {
+    /**
+     * sum_k w[k] kappa(col[k]) (c[col[k]] - c_i) over one CSR row of @p m
+     * bonds in four independent chains (one chain is latency-bound): the
+     * corrosion rows with one kappa per row (neighbours of one phase) or
+     * one per bond from the neighbour's phase flag (interface band).
+     */
+    template <typename Index, typename Kappa>
+#if defined(__GNUC__) && !defined(__clang__)
+    // scalar loads: AVX-512 gathers cost more than they save on such rows
+    __attribute__((optimize("no-tree-vectorize")))
+#endif
+    inline double
+    phase_row_sum(const Index       *col,
+                  const double      *w,
+                  const unsigned int m,
+                  const double      *c,
+                  const double       c_i,
+                  const Kappa       &kappa)
+    {
+      double       s0 = 0., s1 = 0., s2 = 0., s3 = 0.;
+      unsigned int k  = 0;
+      for (; k + 4 <= m; k += 4)
+        {
+          s0 += w[k] * kappa(col[k]) * (c[col[k]] - c_i);
+          s1 += w[k + 1] * kappa(col[k + 1]) * (c[col[k + 1]] - c_i);
+          s2 += w[k + 2] * kappa(col[k + 2]) * (c[col[k + 2]] - c_i);
+          s3 += w[k + 3] * kappa(col[k + 3]) * (c[col[k + 3]] - c_i);
+        }
+      for (; k < m; ++k)
+        s0 += w[k] * kappa(col[k]) * (c[col[k]] - c_i);
+      return (s0 + s1) + (s2 + s3);
+    }
+  } // namespace internal
 } // namespace PeriDEAL
 
 #endif
