@@ -846,9 +846,9 @@ namespace
     solver.model().damage(phi);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
-        r.nodes[disc.id[i]] = {solver.integrator().displacement[0].local_element(i),
-                               solver.integrator().displacement[1].local_element(i),
-                               phi.local_element(i)};
+        r.nodes[disc.id[i]] = {{solver.integrator().displacement[0].local_element(i),
+                                solver.integrator().displacement[1].local_element(i),
+                                phi.local_element(i)}};
         if (std::abs(disc.position[i][1] - lps_crack_y) > 2. * delta)
           r.far_damage = std::max(r.far_damage, phi.local_element(i));
       }
@@ -890,8 +890,8 @@ namespace
     const auto state = [](const MechanicsSolver<2> &s) {
       std::map<types::particle_index, std::array<double, 2>> u;
       for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
-        u[s.discretization().id[i]] = {s.integrator().displacement[0].local_element(i),
-                                       s.integrator().displacement[1].local_element(i)};
+        u[s.discretization().id[i]] = {{s.integrator().displacement[0].local_element(i),
+                                        s.integrator().displacement[1].local_element(i)}};
       return u;
     };
     MechanicsSolver<2> straight(MPI_COMM_WORLD, p);
@@ -940,7 +940,7 @@ namespace
   {
     const double h = 2. * delta / N;
     double       moment = 0., crossing = 0.; // int omega |xi|, int_{xi_n > 0} omega |xi| xi_n
-    std::array<unsigned int, 3> k = {0, 0, 0};
+    std::array<unsigned int, 3> k = {{0, 0, 0}};
     const unsigned int          n_cells = dim == 2 ? N * N : N * N * N;
     for (unsigned int c = 0; c < n_cells; ++c)
       {

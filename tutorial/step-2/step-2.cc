@@ -82,13 +82,13 @@ namespace Step2
     r.nodes            = solver.discretization().n_global();
     const double mass0 = solver.diagnostics().mass;
     double       last_front = front_position(solver);
-    r.history.push_back({0., solver.diagnostics().solid_volume, last_front});
+    r.history.push_back({{0., solver.diagnostics().solid_volume, last_front}});
     while (solver.time() < t_max)
       {
         solver.advance();
         const auto   d     = solver.diagnostics();
         const double front = front_position(solver);
-        r.history.push_back({d.time, d.solid_volume, front});
+        r.history.push_back({{d.time, d.solid_volume, front}});
         r.mass_error = std::max(r.mass_error, std::abs(d.mass - mass0) / mass0);
         r.front_monotone = r.front_monotone && front <= last_front;
         last_front       = front;
