@@ -223,8 +223,7 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::power_iteration_growth(const unsigned int n_steps)
     {
-      const DistributedVector C0 = C;
-      const double            t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      const SavedState saved = save_state();
       random_cloud_start();
       double             log_growth = 0.;
       const unsigned int window     = std::max(1u, n_steps / 4);
@@ -237,11 +236,7 @@ namespace PeriDEAL
           C /= g;
           C.update_ghost_values();
         }
-      C            = C0;
-      t            = t0;
-      abc_seconds  = abc0;
-      step_seconds = step0;
-      C.update_ghost_values();
+      restore_state(saved);
       return std::exp(log_growth / window);
     }
 
@@ -270,8 +265,7 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::arnoldi_spectral_radius(const unsigned int n_warm, const unsigned int n_krylov)
     {
-      const DistributedVector C0 = C;
-      const double            t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      const SavedState saved = save_state();
       random_cloud_start();
       for (unsigned int n = 0; n < n_warm; ++n)
         {
@@ -313,11 +307,7 @@ namespace PeriDEAL
       for (unsigned int i = 0; i < m; ++i)
         for (unsigned int j = 0; j < m; ++j)
           Hm(i, j) = H(i, j);
-      C            = C0;
-      t            = t0;
-      abc_seconds  = abc0;
-      step_seconds = step0;
-      C.update_ghost_values();
+      restore_state(saved);
       return Abc::spectral_radius(Hm);
     }
 
@@ -330,8 +320,7 @@ namespace PeriDEAL
       const unsigned int n = near_field.n_owned();
       check_parameter(n <= max_size, "DoFs of the spectral radius check", n,
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
-      const DistributedVector  C0 = C;
-      const double             t0 = t, abc0 = abc_seconds, step0 = step_seconds;
+      const SavedState         saved = save_state();
       LAPACKFullMatrix<double> map(n, n);
       for (unsigned int col = 0; col < n; ++col)
         {
@@ -342,11 +331,7 @@ namespace PeriDEAL
           for (unsigned int i = 0; i < n; ++i)
             map(i, col) = C.local_element(i);
         }
-      C            = C0;
-      t            = t0;
-      abc_seconds  = abc0;
-      step_seconds = step0;
-      C.update_ghost_values();
+      restore_state(saved);
       return Abc::spectral_radius(map);
     }
 

@@ -436,17 +436,8 @@ namespace PeriDEAL
     // Padding: the neighbour streams read up to the largest offset plus one
     // vector past the last box position.
     sweep_n_alloc = 8 * sweep_n_bytes + sweep_offset.back() + 16;
-    sweep_position.resize(n_local);
-    sweep_node.assign(sweep_n_box, -1);
-    for (std::size_t i = 0; i < n_local; ++i)
-      {
-        std::int64_t L = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          L += std::int64_t(disc.lattice_index[i][d] - sweep_lower[d]) * sweep_stride[d];
-        AssertThrow(sweep_node[L] < 0, ExcInternalError("Two nodes share a lattice position."));
-        sweep_position[i] = L;
-        sweep_node[L]     = i;
-      }
+    internal::LatticeSweep::map_box_positions<dim>(
+      disc.lattice_index, sweep_lower, sweep_stride, sweep_n_box, sweep_position, sweep_node);
     sweep_p.assign(dim * sweep_n_alloc, 0.);
     sweep_reaction.assign(dim * sweep_n_alloc, 0.);
     sweep_bits_valid = false;

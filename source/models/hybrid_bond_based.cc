@@ -438,18 +438,8 @@ namespace PeriDEAL
     sweep_pad       = 8 * std::size_t((reach + 7) / 8);
     sweep_n_vectors = (n_box + 7) / 8;
     sweep_n_alloc   = 2 * sweep_pad + 8 * sweep_n_vectors + 8;
-    const std::size_t n_local = disc.position.size();
-    sweep_position.resize(n_local);
-    sweep_node.assign(8 * sweep_n_vectors, -1);
-    for (std::size_t i = 0; i < n_local; ++i)
-      {
-        std::int64_t L = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          L += std::int64_t(disc.lattice_index[i][d] - sweep_lower[d]) * sweep_stride[d];
-        AssertThrow(sweep_node[L] < 0, ExcInternalError("Two nodes share a lattice position."));
-        sweep_position[i] = L;
-        sweep_node[L]     = i;
-      }
+    internal::LatticeSweep::map_box_positions<dim>(
+      disc.lattice_index, sweep_lower, sweep_stride, 8 * sweep_n_vectors, sweep_position, sweep_node);
     sweep_p.assign(dim * sweep_n_alloc, 0.);
     sweep_u.assign(dim * sweep_n_alloc, 0.);
     sweep_live_valid = false;

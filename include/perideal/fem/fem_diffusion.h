@@ -154,6 +154,26 @@ namespace PeriDEAL
       /** C = the pseudo-random start on the owned cloud DoFs (seeded by global id), normalized. */
       void
       random_cloud_start();
+      /** The state that the stability checks step and then put back. */
+      struct SavedState
+      {
+        DistributedVector C;
+        double            t, abc_seconds, step_seconds;
+      };
+      SavedState
+      save_state() const
+      {
+        return {C, t, abc_seconds, step_seconds};
+      }
+      void
+      restore_state(const SavedState &s)
+      {
+        C            = s.C;
+        t            = s.t;
+        abc_seconds  = s.abc_seconds;
+        step_seconds = s.step_seconds;
+        C.update_ghost_values();
+      }
       const Triangulation<dim>      &tria;
       FemDiffusionParameters         prm;
       FE_Q<dim>                      fe;

@@ -10,8 +10,12 @@
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #  include <immintrin.h>
 
+#  include <deal.II/base/exceptions.h>
+
+#  include <array>
 #  include <cstddef>
 #  include <cstdint>
+#  include <vector>
 
 #  define PERIDEAL_LATTICE_SWEEP_AVX512 1
 
@@ -21,6 +25,33 @@ namespace PeriDEAL
   {
     namespace LatticeSweep
     {
+      /**
+       * Places the nodes in the sweep box: position[i] is the linear box index
+       * of node i (lattice index minus lower, times stride), node[L] the node at
+       * box index L or -1 (n_box entries).
+       */
+      template <int dim>
+      inline void
+      map_box_positions(const std::vector<std::array<int, dim>> &lattice_index,
+                        const std::array<int, dim>              &lower,
+                        const std::array<std::int64_t, dim>     &stride,
+                        const std::size_t                        n_box,
+                        std::vector<std::uint32_t>              &position,
+                        std::vector<std::int32_t>               &node)
+      {
+        position.resize(lattice_index.size());
+        node.assign(n_box, -1);
+        for (std::size_t i = 0; i < lattice_index.size(); ++i)
+          {
+            std::int64_t L = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              L += std::int64_t(lattice_index[i][d] - lower[d]) * stride[d];
+            AssertThrow(node[L] < 0, dealii::ExcMessage("Two nodes share a lattice position."));
+            position[i] = L;
+            node[L]     = i;
+          }
+      }
+
       /**
        * The PMB bond of eight lanes given l2 = |y|^2, the stiffnesses kb,
        * kr = kb rb (rb the lengths) and t2 = (rb + s0 rb)^2: sets brk to the
