@@ -444,6 +444,71 @@ namespace PeriDEAL
     sweep_u.assign(dim * sweep_n_alloc, 0.);
     sweep_live_valid = false;
     sweep_on         = true;
+
+    all_offsets.resize(sweep_offset.size());
+    for (unsigned int f = 0; f < all_offsets.size(); ++f)
+      all_offsets[f] = f;
+    lattice_bound_on = false;
+    if constexpr (dim == 2)
+      if (prm.switching_bound && prm.lattice_bound && std::isfinite(s0))
+        {
+          // Lattice spacings h_d and c = max_f |(a h_x, b h_y)| / r_f (the
+          // offsets' Euclidean lengths against their bond lengths, 1 up to
+          // round-off; rounded up).
+          std::array<int, dim> zero{}, unit{};
+          std::array<double, dim> h;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              unit    = zero;
+              unit[d] = 1;
+              h[d]    = disc.lattice_point(unit).distance(disc.lattice_point(zero));
+            }
+          const int W = 2 * box_radius + 1;
+          double    c = 0.;
+          for (unsigned int f = 0; f < sweep_offset.size(); ++f)
+            {
+              double       len2 = 0.;
+              unsigned int q    = sweep_box[f];
+              for (unsigned int d = 0; d < dim; ++d, q /= W)
+                len2 += std::pow((int(q % W) - box_radius) * h[d], 2);
+              c = std::max(c, std::sqrt(len2) / sweep_r[f]);
+            }
+          c *= 1. + 1e-12;
+          for (unsigned int d = 0; d < dim; ++d)
+            lip_coef[d] = c * c / (h[d] * h[d]);
+          double r_min = std::numeric_limits<double>::max();
+          for (const double r : sweep_r)
+            r_min = std::min(r_min, r);
+          lip_margin = threshold_margin / r_min;
+          // Float arrays over the box, padded by the reach of the windows
+          // (R positions in x, R rows in y) and filled with +inf there.
+          const std::size_t n8 = 8 * sweep_n_vectors;
+          const std::int64_t row = sweep_stride[1];
+          lip_pad = 16 * std::size_t((box_radius * (row + 1) + 31) / 16);
+          lip_ex.assign(n8 + 2 * lip_pad, std::numeric_limits<float>::infinity());
+          lip_ey = lip_ex;
+          lip_fy = lip_ex;
+          lip_prev.assign(dim * sweep_n_alloc, 0.);
+          lip_remaining.assign(n8, -1.);
+          // Edges (L, L + e_d) with both ends at local nodes, in the box
+          // (an x-edge does not wrap to the next row).
+          const std::int64_t n_row = sweep_stride[1];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              lip_edge_ok[d].assign(sweep_n_vectors, 0);
+              const std::int64_t s = sweep_stride[d];
+              for (std::size_t L = 0; L < n8; ++L)
+                {
+                  const bool in_box = std::int64_t(L) + s < std::int64_t(n8) &&
+                                      (d == 1 || (std::int64_t(L) % n_row) + 1 < n_row);
+                  if (in_box && sweep_node[L] >= 0 && sweep_node[L + s] >= 0)
+                    lip_edge_ok[d][L / 8] |= std::uint8_t(1u << (L % 8));
+                }
+            }
+          lip_have_prev    = false;
+          lip_swap_pending = false;
+          lattice_bound_on = true;
+        }
 #endif
   }
 
@@ -604,7 +669,7 @@ namespace PeriDEAL
     double            *crit    = critical.begin();
     const double      *p       = deformed.data();
     const std::int32_t *wf     = wls_mask.data();
-    if (prm.switching_bound)
+    if (prm.switching_bound && !lattice_bound_on)
       {
         std::array<const double *, dim> ud;
         for (unsigned int d = 0; d < dim; ++d)
@@ -740,11 +805,19 @@ namespace PeriDEAL
     // has an Omega_w end whose class-k bound fires (the argument of the
     // class documentation, per class).
     test_lanes.assign(sweep_n_vectors, 0);
-    const unsigned int n_classes = class_bound.size();
-    for (const unsigned int i : active_wls_rows)
-      for (unsigned int k = 0; k < n_classes; ++k)
-        if (!prm.switching_bound || budget[k].needs_check(i))
-          test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << k);
+    const bool         lip       = lattice_bound_on;
+    const unsigned int n_classes = lip ? 1 : class_bound.size();
+    if (lip)
+      {
+        const double start = cpu_seconds();
+        lattice_bound_vectors();
+        seconds[3] += cpu_seconds() - start;
+      }
+    else
+      for (const unsigned int i : active_wls_rows)
+        for (unsigned int k = 0; k < n_classes; ++k)
+          if (!prm.switching_bound || budget[k].needs_check(i))
+            test_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << k);
     // A vector costs the same for one lane as for eight: test (and record)
     // every Omega_w lane of a vector with one to test. An exact test of a
     // node whose bound has not fired finds nothing critical at it (that is
@@ -772,24 +845,30 @@ namespace PeriDEAL
           {
             if (((classes >> k) & 1u) == 0)
               continue;
-            exact_bond_tests += std::uint64_t(__builtin_popcount(lanes)) * class_offsets[k].size();
+            // The lattice bound covers all bonds of a node: one group.
+            const std::vector<unsigned int> &group = lip ? all_offsets : class_offsets[k];
+            exact_bond_tests += std::uint64_t(__builtin_popcount(lanes)) * group.size();
             // First q = max |y|^2 / T^2 only; the (rare) vectors with
             // q >= 1 - 1e-12 are scanned again for the bonds with
             // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
-            __m512d qmax = _mm512_setzero_pd();
-            for (const unsigned int f : class_offsets[k])
+            // Four independent maxima (the chain of one is latency bound).
+            __m512d            qm[4] = {_mm512_setzero_pd(), _mm512_setzero_pd(),
+                                        _mm512_setzero_pd(), _mm512_setzero_pd()};
+            const unsigned int n_g   = group.size();
+            for (unsigned int g = 0; g < n_g; ++g)
               {
-                const __mmask8 alive = bits[f] & lanes;
-                if (alive == 0)
-                  continue;
-                __m512d       y[dim];
-                const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
-                qmax = _mm512_mask_max_pd(qmax, alive, qmax,
-                                          _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
+                const unsigned int f     = group[g];
+                const __mmask8     alive = bits[f] & lanes;
+                __m512d            y[dim];
+                const __m512d      l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
+                qm[g % 4] = _mm512_mask_max_pd(qm[g % 4], alive, qm[g % 4],
+                                               _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
               }
+            const __m512d qmax =
+              _mm512_max_pd(_mm512_max_pd(qm[0], qm[1]), _mm512_max_pd(qm[2], qm[3]));
             if (__builtin_expect(
                   _mm512_cmp_pd_mask(qmax, _mm512_set1_pd(1. - 1e-12), _CMP_GE_OQ) != 0, 0))
-              for (const unsigned int f : class_offsets[k])
+              for (const unsigned int f : group)
                 {
                   const __mmask8 alive = bits[f] & lanes;
                   if (alive == 0)
@@ -815,6 +894,16 @@ namespace PeriDEAL
                           ++overstretched;
                       }
                 }
+            if (lip)
+              {
+                // Slack left: (1 - sqrt(q)) (1 + sigma s0) - margin.
+                const double  kappa = 1. + prm.sigma * s0;
+                const __m512d slack = _mm512_sub_pd(
+                  _mm512_fnmadd_pd(_mm512_set1_pd(kappa), _mm512_sqrt_pd(qmax), _mm512_set1_pd(kappa)),
+                  _mm512_set1_pd(lip_margin));
+                _mm512_mask_storeu_pd(lip_remaining.data() + L0, lanes, slack);
+                continue;
+              }
             alignas(64) double q[8];
             _mm512_store_pd(q, qmax);
             for (unsigned int l = 0; l < 8; ++l)
@@ -825,6 +914,103 @@ namespace PeriDEAL
       }
 #endif
     return n_critical;
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::lattice_bound_vectors()
+  {
+#ifdef PERIDEAL_HYBRID_SWEEP
+    if constexpr (dim == 2)
+      {
+        // (The class documentation, "Lattice bound".) Per test: d = u - u_last
+        // over the box; squared edge norms ex(P) = |d(P + 1) - d(P)|^2,
+        // ey(P) = |d(P + row) - d(P)|^2 (+inf for an edge with a missing
+        // end), rounded up to float; fy = max of ey over [P - R, P + R];
+        // at a node L: G_x^2 = max ex over [L - R, L + R - 1], G_y^2 = max
+        // fy over L + k row, k in [-R, R - 1]. The three stages run in
+        // chunks, each lagging the previous one by its reach, so the arrays
+        // are read back from cache.
+        const std::size_t  N = sweep_n_alloc, n8 = 8 * sweep_n_vectors;
+        const std::int64_t row = sweep_stride[1];
+        const int          R   = box_radius;
+        lip_swap_pending       = true;
+        if (!lip_have_prev)
+          {
+            // The first test: no increments yet, test every Omega_w vector.
+            lip_have_prev = true;
+            for (std::size_t v = 0; v < sweep_n_vectors; ++v)
+              test_lanes[v] = wls_lanes[v] != 0;
+            return;
+          }
+        const double *u = sweep_u.data() + sweep_pad, *w = lip_prev.data() + sweep_pad;
+        float        *ex = lip_ex.data() + lip_pad, *ey = lip_ey.data() + lip_pad,
+              *fy = lip_fy.data() + lip_pad;
+        double         *rem = lip_remaining.data();
+        const __m512d   inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+        const __m512d   cx = _mm512_set1_pd(lip_coef[0]), cy = _mm512_set1_pd(lip_coef[1]);
+        const auto edges = [&](const std::size_t L0) {
+          const __m512d d0 = _mm512_sub_pd(_mm512_loadu_pd(u + L0), _mm512_loadu_pd(w + L0));
+          const __m512d d1 =
+            _mm512_sub_pd(_mm512_loadu_pd(u + N + L0), _mm512_loadu_pd(w + N + L0));
+          const std::int64_t s[2] = {1, row};
+          float             *out[2] = {ex, ey};
+          for (unsigned int e = 0; e < 2; ++e)
+            {
+              const std::size_t M  = L0 + s[e];
+              const __m512d     a0 = _mm512_sub_pd(
+                _mm512_sub_pd(_mm512_loadu_pd(u + M), _mm512_loadu_pd(w + M)), d0);
+              const __m512d a1 = _mm512_sub_pd(
+                _mm512_sub_pd(_mm512_loadu_pd(u + N + M), _mm512_loadu_pd(w + N + M)), d1);
+              const __m512d n2 =
+                _mm512_mask_mov_pd(inf, lip_edge_ok[e][L0 / 8],
+                                   _mm512_fmadd_pd(a1, a1, _mm512_mul_pd(a0, a0)));
+              _mm256_storeu_ps(out[e] + L0,
+                               _mm512_cvt_roundpd_ps(n2, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+            }
+        };
+        const auto x_window = [&](const std::size_t L0) {
+          __m256 m = _mm256_loadu_ps(ey + L0 - R);
+          for (int k = -R + 1; k <= R; ++k)
+            m = _mm256_max_ps(m, _mm256_loadu_ps(ey + L0 + k));
+          _mm256_storeu_ps(fy + L0, m);
+        };
+        const auto grow = [&](const std::size_t L0) {
+          const std::size_t v     = L0 / 8;
+          const __mmask8    lanes = wls_lanes[v];
+          if (lanes == 0)
+            return;
+          __m256 gx = _mm256_loadu_ps(ex + L0 - R), gy = _mm256_loadu_ps(fy + L0 - R * row);
+          for (int k = -R + 1; k < R; ++k)
+            {
+              gx = _mm256_max_ps(gx, _mm256_loadu_ps(ex + L0 + k));
+              gy = _mm256_max_ps(gy, _mm256_loadu_ps(fy + L0 + k * row));
+            }
+          const __m512d H = _mm512_sqrt_pd(
+            _mm512_fmadd_pd(cy, _mm512_cvtps_pd(gy), _mm512_mul_pd(cx, _mm512_cvtps_pd(gx))));
+          const __m512d r = _mm512_sub_pd(_mm512_loadu_pd(rem + L0), H);
+          _mm512_storeu_pd(rem + L0, r);
+          // Not > 0 (NaN too): test.
+          if (_mm512_mask_cmp_pd_mask(lanes, r, _mm512_setzero_pd(), _CMP_NGT_UQ) != 0)
+            test_lanes[v] = 1;
+        };
+        const std::size_t chunk = 512, lag3 = 8 * std::size_t((R + 15) / 8),
+                          lag4 = 8 * std::size_t((std::max(R - 1, 0) * row + 15) / 8);
+        std::size_t f2 = 0, f3 = 0, f4 = 0;
+        while (f4 < n8)
+          {
+            const std::size_t e2 = std::min(n8, f2 + chunk);
+            for (; f2 < e2; f2 += 8)
+              edges(f2);
+            const std::size_t e3 = f2 == n8 ? n8 : (f2 > lag3 ? f2 - lag3 : 0);
+            for (; f3 < e3; f3 += 8)
+              x_window(f3);
+            const std::size_t e4 = f3 == n8 ? n8 : (f3 > lag4 ? f3 - lag4 : 0);
+            for (; f4 < e4; f4 += 8)
+              grow(f4);
+          }
+      }
+#endif
   }
 
   template <int dim>
@@ -954,6 +1140,11 @@ namespace PeriDEAL
         // p and u over the box (the same p as the row loops).
         if (!sweep_live_valid)
           build_live_bits();
+        // The lattice bound keeps u of the last test: the buffer of sweep_u
+        // at that test becomes lip_prev (both are zero off the nodes).
+        if (lip_swap_pending)
+          std::swap(sweep_u, lip_prev);
+        lip_swap_pending = false;
         const std::size_t N = sweep_n_alloc;
         for (unsigned int d = 0; d < dim; ++d)
           {

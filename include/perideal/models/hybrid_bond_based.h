@@ -38,6 +38,15 @@ namespace PeriDEAL
      * tests every bond at every test (the reference, for verification).
      */
     bool switching_bound = true;
+    /**
+     * With switching_bound, in 2D lattice sweeps (uses_lattice_sweep()):
+     * bound the growth of the bond lengths by a Lipschitz bound of the
+     * displacement increments on the lattice (one class, all bonds of a
+     * node) instead of StretchBudget's increment boxes per length class.
+     * The outcome is the same (both are conservative); only the number of
+     * exact node tests differs.
+     */
+    bool lattice_bound = true;
   };
 
   /**
@@ -91,6 +100,21 @@ namespace PeriDEAL
    * own StretchBudget (reach: the class's longest bond) and slack (its
    * shortest bond); a node tests (and records) the bonds of each class whose
    * bound fired, the argument above holding per class.
+   * Lattice bound (HybridMechanicsParameters::lattice_bound, 2D sweeps):
+   * for a bond of lattice offset (a, b), |u_j - u_i| is at most the sum of
+   * the nearest-neighbour differences along the lattice path from i along
+   * x to (j_x, i_y), then along y to j, so that
+   * |D_j - D_i| <= |a| G_x + |b| G_y <= r_b c sqrt(G_x^2 / h_x^2 + G_y^2 / h_y^2)
+   * (Cauchy-Schwarz, c = max over the offsets of |(a h_x, b h_y)| / r_b,
+   * i.e. 1), with G_x the largest |d_P+1 - d_P| over the x-edges of i's
+   * row within the stencil radius R, G_y the largest over the y-edges of
+   * the (2R + 1) x 2R window (an edge with a missing end counts as
+   * infinite), d the displacement increments since the last test. So the
+   * stretch of every bond of i grows by at most H_i = c sqrt(...) per test
+   * interval, whatever its length, and i needs no exact test while
+   * sum H_i < (1 - sqrt(q_i)) (1 + sigma s0) minus the round-off margin.
+   * The window maxima are separable sliding maxima over the box (edge
+   * norms rounded up to float), O(R) per position and test.
    * Switching is rank independent: each rank marks the owned end points of
    * its critical bonds (a bond to a ghost is tested on both ranks with
    * bitwise the same length), one global sum tells whether anything is
@@ -179,6 +203,7 @@ namespace PeriDEAL
       op_stale    = false;
       for (auto &b : budget) // bonds may have been restored
         b.invalidate();
+      std::fill(lip_remaining.begin(), lip_remaining.end(), -1.);
       sweep_live_valid = false;
     }
     std::uint64_t
@@ -352,6 +377,9 @@ namespace PeriDEAL
     /** The sweep versions of the switching test and of the rows. */
     std::uint64_t
     sweep_switching_test();
+    /** The lattice bound: advance it to the current sweep_u, mark the vectors to test. */
+    void
+    lattice_bound_vectors();
     bool
     sweep_standard_rows(VectorField &force);
     void
@@ -449,6 +477,23 @@ namespace PeriDEAL
     std::vector<double>       shared_weight;
     std::vector<std::uint8_t> shared_row;
     unsigned int              n_shared_rows = 0;
+    /**
+     * The lattice bound (2D): on; c^2 / h_d^2; margin / r_min; float pad of
+     * the edge arrays; u at the last test over the box (layout of sweep_u,
+     * swapped with it after a test); per box position, the slack left
+     * (< 0: test); squared edge norms of the increments in x and y and the
+     * x-window maxima of the latter (padded, +inf outside the box); per
+     * vector and direction, the lanes whose edge has both ends; all offsets.
+     */
+    bool                       lattice_bound_on = false;
+    std::array<double, 2>      lip_coef{};
+    double                     lip_margin = 0.;
+    std::size_t                lip_pad    = 0;
+    std::vector<double>        lip_prev, lip_remaining;
+    std::vector<float>         lip_ex, lip_ey, lip_fy;
+    std::array<std::vector<std::uint8_t>, 2> lip_edge_ok;
+    std::vector<unsigned int>  all_offsets;
+    bool                       lip_have_prev = false, lip_swap_pending = false;
     /** @} */
     unsigned int        n_evaluations = 0;
     unsigned int        switch_events = 0;
