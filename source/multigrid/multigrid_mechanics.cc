@@ -1,3 +1,5 @@
+#include <deal.II/base/utilities.h>
+
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 #include <deal.II/lac/vector.h>
@@ -461,11 +463,24 @@ namespace PeriDEAL
               B.paid_position.push_back(P);
             }
         }
-      for (unsigned int i = 0; i < L.n_nodes; ++i)
-        B.state[B.position[i]] = 1 + active_flag[g][i];
+      if (!B.state_valid)
+        for (unsigned int i = 0; i < L.n_nodes; ++i)
+          B.state[B.position[i]] = 1 + active_flag[g][i];
+      B.state_valid = true;
       // live = intact & (evaluated(P) | evaluated(P + o)), 64 positions at
-      // a time: bit P of the evaluated bits shifted by o is bit P + o.
-      B.live.resize(H * W);
+      // a time: bit P of the evaluated bits shifted by o is bit P + o. A
+      // change of E at Q changes the live bits of P = Q - o .. Q only.
+      std::size_t w_begin = 0, w_end = W;
+      if (B.live_valid && B.live.size() == H * W && B.any.size() == W)
+        {
+          w_begin = std::max<long>(B.dirty_lo - B.o_max, 0) / 64;
+          w_end   = B.dirty_hi > B.dirty_lo ? std::min<std::size_t>((B.dirty_hi + 63) / 64, W) : 0;
+        }
+      else
+        {
+          B.live.resize(H * W);
+          B.any.assign(W, 0);
+        }
       const std::uint64_t *E = B.evaluated_bits.data();
       for (unsigned int h = 0; h < H; ++h)
         {
@@ -473,7 +488,7 @@ namespace PeriDEAL
           const unsigned int  r = B.offset[h] % 64;
           const std::uint64_t *I = B.intact.data() + h * W;
           std::uint64_t       *Z = B.live.data() + h * W;
-          for (std::size_t w = 0; w < W; ++w)
+          for (std::size_t w = w_begin; w < w_end; ++w)
             {
               const std::uint64_t shifted =
                 r == 0 ? E[w + q] : (E[w + q] >> r) | (E[w + q + 1] << (64 - r));
@@ -482,10 +497,16 @@ namespace PeriDEAL
         }
       // Groups of eight positions with a live bit for some offset, per
       // chunk (the sweep visits only these).
-      std::vector<std::uint64_t> any(W, 0);
+      // Over all words: the sweep has cleared the live bits of the bonds
+      // broken since the last build, so groups may have emptied anywhere.
+      std::fill(B.any.begin(), B.any.end(), 0);
       for (unsigned int h = 0; h < H; ++h)
         for (std::size_t w = 0; w < W; ++w)
-          any[w] |= B.live[h * W + w];
+          B.any[w] |= B.live[h * W + w];
+      const auto &any = B.any;
+      B.live_valid    = true;
+      B.dirty_lo      = std::numeric_limits<long>::max();
+      B.dirty_hi      = std::numeric_limits<long>::min();
       const unsigned int groups_per_chunk = sweep_chunk / 8;
       B.group_start.assign(1, 0);
       B.groups.clear();
@@ -511,14 +532,19 @@ namespace PeriDEAL
         return;
       B.filled          = u_version;
       const std::size_t N = B.n_alloc;
-      const auto       &U = u[g];
-      for (const auto *list : {&active[g], &fictitious[g]})
-        for (const unsigned int i : *list)
-          {
-            const long P = B.position[i];
-            for (unsigned int d = 0; d < dim; ++d)
-              B.p[d * N + P] = B.reference[d * N + P] + U[dim * i + d];
-          }
+      const double     *U = u[g].data();
+      for (const auto &[i0, n] : filled_runs[g])
+        {
+          const long P = B.position[i0];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double *__restrict       p = B.p.data() + d * N + P;
+              const double *__restrict x = B.reference.data() + d * N + P;
+              const double *__restrict w = U + dim * i0 + d;
+              for (unsigned int t = 0; t < n; ++t)
+                p[t] = x[t] + w[dim * t];
+            }
+        }
     }
 
     template <int dim>
@@ -676,7 +702,9 @@ namespace PeriDEAL
           active_flag[g].assign(grids[g].n_nodes, 0);
           active[g].clear();
           fictitious[g].clear();
-          boxes[g].valid = false;
+          boxes[g].valid       = false;
+          boxes[g].state_valid = false;
+          boxes[g].live_valid  = false;
         }
       for (unsigned int i = 0; i < C.n_nodes; ++i)
         if (!refined[i])
@@ -692,26 +720,7 @@ namespace PeriDEAL
           }
 
       // An inactive node is fictitious if an active node of its grid has it
-      // in its stencil (the stencil is symmetric: search its own stencil).
-      const auto has_active_neighbour = [&](const Grid g, const unsigned int i) {
-        const Lattice &L  = grids[g];
-        const auto     ix = L.index(i);
-        const bool     in = L.interior(i);
-        for (unsigned int k = 0; k < L.offset.size(); ++k)
-          {
-            if (!in)
-              {
-                auto jx = ix;
-                for (unsigned int d = 0; d < dim; ++d)
-                  jx[d] += L.offset[k][d];
-                if (!L.inside(jx))
-                  continue;
-              }
-            if (active_flag[g][i + L.linear_offset[k]])
-              return true;
-          }
-        return false;
-      };
+      // in its stencil.
       if (!active[coarse].empty())
         for (unsigned int i = 0; i < C.n_nodes; ++i)
           if (refined[i] && has_active_neighbour(coarse, i))
@@ -792,45 +801,220 @@ namespace PeriDEAL
             }
         }
 
-      // Interpolation rows: every inactive coarse node that is fictitious
-      // or a source of a fine fictitious node (from the fine nodes around
-      // it, all active), then the fine fictitious nodes (from coarse nodes).
+      update_interpolation_rows({}, {});
+      update_runs();
+    }
+
+    template <int dim>
+    unsigned int
+    MechanicsSolver<dim>::child(const unsigned int cell, const unsigned int q) const
+    {
+      const auto           ix = grids[coarse].index(cell);
+      std::array<int, dim> fx;
+      unsigned int         rest = q;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          fx[d] = ix[d] * ratio + rest % ratio;
+          rest /= ratio;
+        }
+      return grids[fine].node(fx);
+    }
+
+    template <int dim>
+    bool
+    MechanicsSolver<dim>::has_active_neighbour(const Grid g, const unsigned int i) const
+    {
+      // The stencil is symmetric: search i's own stencil.
+      return grids[g].any_neighbour(i, [&](const unsigned int j) { return active_flag[g][j] != 0; });
+    }
+
+    template <int dim>
+    void
+    MechanicsSolver<dim>::update_node_sets(const std::vector<unsigned int> &cells)
+    {
+      // Only the new fine nodes (children of @p cells) become active and
+      // only these cells' coarse nodes inactive. So a fine node becomes
+      // fictitious only if it is inactive and in the stencil of a new fine
+      // node, and stops being fictitious only by becoming active; a coarse
+      // node can change only if it is one of the cells or was fictitious.
+      // The result equals update_node_sets() (same ascending lists).
+      const Lattice     &F          = grids[fine];
+      const unsigned int n_children = Utilities::fixed_power<dim>(ratio);
+      std::vector<unsigned int> children;
+      children.reserve(cells.size() * n_children);
+      const auto mark_dirty = [&](const Grid g, const unsigned int i) {
+        Box &B     = boxes[g];
+        B.dirty_lo = std::min(B.dirty_lo, B.position[i]);
+        B.dirty_hi = std::max(B.dirty_hi, B.position[i] + 1);
+      };
+      for (const unsigned int i : cells)
+        {
+          active_flag[coarse][i]                          = 0;
+          boxes[coarse].state[boxes[coarse].position[i]] = 1;
+          mark_dirty(coarse, i);
+          for (unsigned int q = 0; q < n_children; ++q)
+            {
+              const unsigned int f = child(i, q);
+              active_flag[fine][f]                      = 1;
+              boxes[fine].state[boxes[fine].position[f]] = 2;
+              mark_dirty(fine, f);
+              children.push_back(f);
+            }
+        }
+      std::sort(children.begin(), children.end());
+      for (const unsigned int g : {0u, 1u})
+        boxes[g].valid = false;
+      auto &ac = active[coarse];
+      ac.erase(std::remove_if(ac.begin(), ac.end(),
+                              [&](const unsigned int i) { return !active_flag[coarse][i]; }),
+               ac.end());
+      {
+        std::vector<unsigned int> merged(active[fine].size() + children.size());
+        std::merge(active[fine].begin(), active[fine].end(), children.begin(), children.end(),
+                   merged.begin());
+        active[fine].swap(merged);
+      }
+
+      std::vector<unsigned int> fict_fine, fict_coarse;
+      std::vector<std::uint8_t> &mark = fine_mark;
+      mark.resize(F.n_nodes, 0);
+      for (const unsigned int f : fictitious[fine])
+        if (!active_flag[fine][f])
+          {
+            fict_fine.push_back(f);
+            mark[f] = 1;
+          }
+      for (const unsigned int f : children)
+        F.any_neighbour(f, [&](const unsigned int j) {
+          if (!active_flag[fine][j] && !mark[j])
+            {
+              mark[j] = 1;
+              fict_fine.push_back(j);
+            }
+          return false;
+        });
+      for (const unsigned int f : fict_fine)
+        mark[f] = 0;
+      std::sort(fict_fine.begin(), fict_fine.end());
+      const std::vector<unsigned int> &old_fictitious = fictitious[coarse];
+      for (const auto *list : {&old_fictitious, &cells})
+        for (const unsigned int i : *list)
+          if (has_active_neighbour(coarse, i))
+            fict_coarse.push_back(i);
+      std::sort(fict_coarse.begin(), fict_coarse.end());
+      fict_coarse.erase(std::unique(fict_coarse.begin(), fict_coarse.end()), fict_coarse.end());
+
+      const std::vector<unsigned int> old_fine = std::move(fictitious[fine]),
+                                      old_coarse = coarse_interpolated;
+      fictitious[fine].swap(fict_fine);
+      fictitious[coarse].swap(fict_coarse);
+      update_interpolation_rows(old_fine, old_coarse);
+      update_runs();
+    }
+
+    template <int dim>
+    void
+    MechanicsSolver<dim>::update_runs()
+    {
+      const auto make_runs = [](const Lattice                                      &L,
+                                const auto                                         &include,
+                                std::vector<std::pair<unsigned int, unsigned int>> &runs) {
+        runs.clear();
+        for (unsigned int i = 0; i < L.n_nodes; ++i)
+          if (include(i))
+            {
+              if (!runs.empty() && runs.back().first + runs.back().second == i &&
+                  i % L.n[0] != 0)
+                ++runs.back().second;
+              else
+                runs.emplace_back(i, 1);
+            }
+      };
+      for (const unsigned int g : {0u, 1u})
+        {
+          const auto &flag = active_flag[g];
+          make_runs(grids[g], [&](const unsigned int i) { return flag[i] != 0; }, active_runs[g]);
+          // Fictitious nodes are inactive: mark them to merge the two lists.
+          std::vector<std::uint8_t> filled(flag);
+          for (const unsigned int i : fictitious[g])
+            filled[i] = 1;
+          make_runs(grids[g], [&](const unsigned int i) { return filled[i] != 0; },
+                    filled_runs[g]);
+          prescribed_active[g].clear();
+          for (const unsigned int i : active[g])
+            if (prescribed[g][i])
+              prescribed_active[g].push_back(i);
+        }
+      wls_runs.clear();
+      if (!use_wls.empty())
+        make_runs(grids[coarse],
+                  [&](const unsigned int i) { return active_flag[coarse][i] && use_wls[i]; },
+                  wls_runs);
+    }
+
+    template <int dim>
+    void
+    MechanicsSolver<dim>::update_interpolation_rows(const std::vector<unsigned int> &old_fine,
+                                                    const std::vector<unsigned int> &old_coarse)
+    {
+      // Every inactive coarse node that is fictitious or a source of a fine
+      // fictitious node (interpolated from the fine nodes around it, all
+      // active), then the fine fictitious nodes (from coarse nodes).
+      const Lattice &C = grids[coarse], &F = grids[fine];
       std::vector<std::pair<unsigned int, double>> src;
-      std::vector<std::uint8_t>                    mark(C.n_nodes, 0);
+      // Node list, CSR rows and the row of node i: copied from the old rows
+      // if i is in the old list (ascending, like the new one), else computed.
+      const auto rows = [&](const Grid                       g,
+                            const std::vector<unsigned int> &list,
+                            const std::vector<unsigned int> &old_list,
+                            const auto                      &point,
+                            const auto                      &on_source) {
+        const std::vector<unsigned int> old_start  = std::move(interp_start[g]),
+                                        old_source = std::move(interp_source[g]);
+        const std::vector<double>       old_weight = std::move(interp_weight[g]);
+        interp_start[g].assign(1, 0);
+        interp_source[g].clear();
+        interp_weight[g].clear();
+        std::size_t r_old = 0;
+        for (const unsigned int i : list)
+          {
+            while (r_old < old_list.size() && old_list[r_old] < i)
+              ++r_old;
+            if (r_old < old_list.size() && old_list[r_old] == i)
+              for (auto b = old_start[r_old]; b < old_start[r_old + 1]; ++b)
+                {
+                  interp_source[g].push_back(old_source[b]);
+                  interp_weight[g].push_back(old_weight[b]);
+                }
+            else
+              {
+                interpolation_sources(Grid(1 - g), point(i), src);
+                for (const auto &[j, w] : src)
+                  {
+                    interp_source[g].push_back(j);
+                    interp_weight[g].push_back(w);
+                  }
+              }
+            for (auto b = interp_start[g].back(); b < interp_source[g].size(); ++b)
+              on_source(interp_source[g][b]);
+            interp_start[g].push_back(interp_source[g].size());
+          }
+      };
+      std::vector<std::uint8_t> mark(C.n_nodes, 0);
       for (const auto i : fictitious[coarse])
         mark[i] = 1;
-      interp_start[fine].assign(1, 0);
-      interp_source[fine].clear();
-      interp_weight[fine].clear();
-      for (const auto f : fictitious[fine])
-        {
-          interpolation_sources(coarse, F.point(f), src);
-          for (const auto &[j, w] : src)
-            {
-              interp_source[fine].push_back(j);
-              interp_weight[fine].push_back(w);
-              if (!active_flag[coarse][j])
-                mark[j] = 1;
-            }
-          interp_start[fine].push_back(interp_source[fine].size());
-        }
+      rows(fine, fictitious[fine], old_fine, [&](const unsigned int f) { return F.point(f); },
+           [&](const unsigned int j) {
+             if (!active_flag[coarse][j])
+               mark[j] = 1;
+           });
       coarse_interpolated.clear();
-      interp_start[coarse].assign(1, 0);
-      interp_source[coarse].clear();
-      interp_weight[coarse].clear();
       for (unsigned int i = 0; i < C.n_nodes; ++i)
         if (mark[i])
-          {
-            coarse_interpolated.push_back(i);
-            interpolation_sources(fine, C.point(i), src);
-            for (const auto &[j, w] : src)
-              {
-                AssertThrow(active_flag[fine][j], ExcInternalError());
-                interp_source[coarse].push_back(j);
-                interp_weight[coarse].push_back(w);
-              }
-            interp_start[coarse].push_back(interp_source[coarse].size());
-          }
+          coarse_interpolated.push_back(i);
+      rows(coarse, coarse_interpolated, old_coarse,
+           [&](const unsigned int i) { return C.point(i); },
+           [&](const unsigned int j) { AssertThrow(active_flag[fine][j], ExcInternalError()); });
     }
 
     template <int dim>
@@ -988,63 +1172,82 @@ namespace PeriDEAL
     void
     MechanicsSolver<dim>::wls_forces()
     {
-      // Over the coarse box positions from the first to the last WLS
-      // node, one stencil offset at a time (contiguous, vectorized); nodes
-      // that are not active WLS nodes get values that are not used.
+      // Over the runs of active WLS nodes (consecutive coarse box
+      // positions), one stencil offset at a time (contiguous, vectorized).
       Box              &B = boxes[coarse];
       const std::size_t N = B.n_alloc;
-      long              lo = std::numeric_limits<long>::max(), hi = 0;
-      for (const unsigned int i : active[coarse])
-        if (use_wls[i])
-          {
-            lo = std::min(lo, B.position[i]);
-            hi = std::max(hi, B.position[i] + 1);
-          }
-      if (hi <= lo)
+      if (wls_runs.empty())
         return;
       if (wls_u.size() != dim * N)
+        wls_u.assign(dim * N, 0.);
+      const double *U = u[coarse].data();
+      for (const auto &[i0, n] : filled_runs[coarse])
         {
-          wls_u.assign(dim * N, 0.);
-          wls_f.assign(dim * N, 0.);
+          const long P = B.position[i0];
+          for (unsigned int d = 0; d < dim; ++d)
+            for (unsigned int t = 0; t < n; ++t)
+              wls_u[d * N + P + t] = U[dim * (i0 + t) + d];
         }
-      const auto &U = u[coarse];
-      for (const auto *list : {&active[coarse], &fictitious[coarse]})
-        for (const unsigned int i : *list)
-          for (unsigned int d = 0; d < dim; ++d)
-            wls_u[d * N + B.position[i]] = U[dim * i + d];
-      // Chunks of positions (the chunk's forces in L1), all offsets per chunk.
-      constexpr std::size_t C = 256;
-      alignas(64) double    f[dim][C];
-      for (std::size_t c0 = lo; c0 < std::size_t(hi); c0 += C)
-        {
-          const std::size_t n = std::min<std::size_t>(C, hi - c0);
-          for (unsigned int d = 0; d < dim; ++d)
-            std::fill(f[d], f[d] + n, 0.);
-          for (unsigned int k = 0; k < wls_box_offset.size(); ++k)
-            {
-              const double *w = &wls_weight[k * dim * dim];
-              for (unsigned int e2 = 0; e2 < dim; ++e2)
-                {
-                  const double *__restrict us = wls_u.data() + e2 * N + c0 + wls_box_offset[k];
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      const double         we = w[d * dim + e2];
-                      double *__restrict fd = f[d];
+      // Chunks of a run (the chunk's forces in L1); per pass over a chunk
+      // two offsets, all components (per position the same sum order as
+      // one offset and one component at a time: offset, then component of u).
+      constexpr unsigned int C = 256;
+      alignas(64) double     f[dim][C];
+      const double           inv_rho = 1. / prm.density;
+      double                *A       = a[coarse].data();
+      const unsigned int     K       = wls_box_offset.size();
+      for (const auto &[i0, n_run] : wls_runs)
+        for (unsigned int t0 = 0; t0 < n_run; t0 += C)
+          {
+            const unsigned int n  = std::min(C, n_run - t0);
+            const std::size_t  c0 = B.position[i0] + t0;
+            for (unsigned int d = 0; d < dim; ++d)
+              std::fill(f[d], f[d] + n, 0.);
+            for (unsigned int k = 0; k < K; k += 2)
+              {
+                const unsigned int n_k = std::min(2u, K - k);
+                const double      *u0[dim], *u1[dim];
+                for (unsigned int e2 = 0; e2 < dim; ++e2)
+                  {
+                    u0[e2] = wls_u.data() + e2 * N + c0 + wls_box_offset[k];
+                    u1[e2] = wls_u.data() + e2 * N + c0 + wls_box_offset[k + n_k - 1];
+                  }
+                const double *w0 = &wls_weight[k * dim * dim],
+                             *w1 = &wls_weight[(k + n_k - 1) * dim * dim];
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    double *__restrict fd = f[d];
+                    if (n_k == 2)
+                      {
 #pragma omp simd
-                      for (std::size_t q = 0; q < n; ++q)
-                        fd[q] += we * us[q];
-                    }
-                }
-            }
-          for (unsigned int d = 0; d < dim; ++d)
-            std::copy(f[d], f[d] + n, wls_f.begin() + d * N + c0);
-        }
-      const double inv_rho = 1. / prm.density;
-      auto        &A       = a[coarse];
-      for (const unsigned int i : active[coarse])
-        if (use_wls[i])
-          for (unsigned int d = 0; d < dim; ++d)
-            A[dim * i + d] = wls_f[d * N + B.position[i]] * inv_rho;
+                        for (unsigned int q = 0; q < n; ++q)
+                          {
+                            double s = fd[q];
+                            for (unsigned int e2 = 0; e2 < dim; ++e2)
+                              s += w0[d * dim + e2] * u0[e2][q];
+                            for (unsigned int e2 = 0; e2 < dim; ++e2)
+                              s += w1[d * dim + e2] * u1[e2][q];
+                            fd[q] = s;
+                          }
+                      }
+                    else
+                      {
+#pragma omp simd
+                        for (unsigned int q = 0; q < n; ++q)
+                          {
+                            double s = fd[q];
+                            for (unsigned int e2 = 0; e2 < dim; ++e2)
+                              s += w0[d * dim + e2] * u0[e2][q];
+                            fd[q] = s;
+                          }
+                      }
+                  }
+              }
+            double *Ai = A + dim * (i0 + t0);
+            for (unsigned int q = 0; q < n; ++q)
+              for (unsigned int d = 0; d < dim; ++d)
+                Ai[dim * q + d] = f[d][q] * inv_rho;
+          }
     }
 
     template <int dim>
@@ -1238,25 +1441,15 @@ namespace PeriDEAL
                   (*field)[coarse][dim * i + d] = s;
                 }
           }
-      unsigned int n_new = 0;
+      std::vector<unsigned int> new_cells;
       const unsigned int n_children = std::pow(ratio, dim);
       std::vector<unsigned int> children(n_children);
       for (unsigned int i = 0; i < C.n_nodes; ++i)
         if (zone[i] && !refined[i])
           {
-            ++n_new;
-            const auto ix = C.index(i);
+            new_cells.push_back(i);
             for (unsigned int q = 0; q < n_children; ++q)
-              {
-                std::array<int, dim> fx;
-                unsigned int         rest = q;
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    fx[d] = ix[d] * ratio + rest % ratio;
-                    rest /= ratio;
-                  }
-                children[q] = F.node(fx);
-              }
+              children[q] = child(i, q);
             // Interpolate, then shift so that the cell keeps its coarse
             // node's displacement, velocity and acceleration as the mean
             // (mass and momentum of the cell unchanged).
@@ -1289,13 +1482,13 @@ namespace PeriDEAL
             refined[i] = 1;
           }
       ++u_version;
-      if (n_new > 0)
+      if (!new_cells.empty())
         {
-          update_node_sets();
+          update_node_sets(new_cells);
           for (const Grid g : {coarse, fine})
             build_box_bits(g);
         }
-      return n_new;
+      return new_cells.size();
     }
 
     template <int dim>
@@ -1331,25 +1524,32 @@ namespace PeriDEAL
     MechanicsSolver<dim>::advance()
     {
       const double h = 0.5 * dt;
+      // Over runs of consecutive active nodes (contiguous dim-interleaved values).
       for (const unsigned int g : {0u, 1u})
-        for (const unsigned int i : active[g])
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              v[g][dim * i + d] += h * a[g][dim * i + d];
-              u[g][dim * i + d] += dt * v[g][dim * i + d];
-            }
-      compute_accelerations();
-      for (const unsigned int g : {0u, 1u})
-        for (const unsigned int i : active[g])
+        for (const auto &[i0, n] : active_runs[g])
           {
-            if (prescribed[g][i])
+            double *__restrict       U = u[g].data() + dim * i0;
+            double *__restrict       V = v[g].data() + dim * i0;
+            const double *__restrict A = a[g].data() + dim * i0;
+            for (unsigned int j = 0; j < dim * n; ++j)
               {
-                for (unsigned int d = 0; d < dim; ++d)
-                  a[g][dim * i + d] = 0.;
-                continue;
+                V[j] += h * A[j];
+                U[j] += dt * V[j];
               }
-            for (unsigned int d = 0; d < dim; ++d)
-              v[g][dim * i + d] += h * a[g][dim * i + d];
+          }
+      compute_accelerations();
+      // Prescribed nodes keep their velocity: a = 0 (v + h 0 = v).
+      for (const unsigned int g : {0u, 1u})
+        for (const unsigned int i : prescribed_active[g])
+          for (unsigned int d = 0; d < dim; ++d)
+            a[g][dim * i + d] = 0.;
+      for (const unsigned int g : {0u, 1u})
+        for (const auto &[i0, n] : active_runs[g])
+          {
+            double *__restrict       V = v[g].data() + dim * i0;
+            const double *__restrict A = a[g].data() + dim * i0;
+            for (unsigned int j = 0; j < dim * n; ++j)
+              V[j] += h * A[j];
           }
       t += dt;
       ++n_step;
@@ -1410,6 +1610,7 @@ namespace PeriDEAL
             }
           boxes[g].valid        = false;
           boxes[g].intact_valid = false;
+          boxes[g].live_valid   = false;
         }
     }
 
@@ -1455,6 +1656,7 @@ namespace PeriDEAL
         for (unsigned int i = 0; i < grids[g].n_nodes; ++i)
           if (region(grids[g].point(i)))
             prescribed[g][i] = prescribed_velocity.size();
+      update_runs();
       apply_prescribed();
     }
 

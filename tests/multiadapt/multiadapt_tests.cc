@@ -64,6 +64,67 @@ namespace
     return p;
   }
 
+  // A switch updates the node sets, interpolation rows and live bits only
+  // near the refined cells: after three refinements the solver must equal
+  // one built with the same refined cells from the start (same active and
+  // fictitious nodes, bitwise the same accelerations of a nonlinear field
+  // and the same state after a few steps).
+  void
+  incremental_switch()
+  {
+    for (const auto model : {MechanicsModel::adaptive_standard, MechanicsModel::adaptive_hybrid})
+      {
+        const std::string name = to_string(model);
+        Solver<2>         s(plate(model, Interpolation::inverse_distance));
+        const std::vector<std::function<bool(const Point<2> &)>> regions{
+          [](const Point<2> &x) { return x.distance(Point<2>(31., 19.)) < 5.; },
+          [](const Point<2> &x) { return x[1] > 33. && x[0] > 20. && x[0] < 36.; },
+          [](const Point<2> &x) { return x[0] < 5. && x[1] < 9.; }};
+        for (const auto &region : regions)
+          check(s.refine_region(region) > 0, name + ": cells refined on request");
+        const std::vector<std::uint8_t> refined = s.refined_cells();
+        auto                            p       = plate(model, Interpolation::inverse_distance);
+        p.initial_fine_region                   = [&refined, &p](const Point<2> &x) {
+          const unsigned int ix = std::lround((x[0] - p.lower[0]) / p.coarse_dx - 0.5),
+                             iy = std::lround((x[1] - p.lower[1]) / p.coarse_dx - 0.5),
+                             nx = std::lround((p.upper[0] - p.lower[0]) / p.coarse_dx);
+          return refined[iy * nx + ix] != 0;
+        };
+        Solver<2> fresh(p);
+        const auto field = [](const Point<2> &x) {
+          return Tensor<1, 2>({1e-3 * std::sin(x[0] / 7.) * x[1] / 40., 1e-3 * std::cos(x[1] / 5.)});
+        };
+        double max_a = 0., max_u = 0.;
+        for (Solver<2> *t : {&s, &fresh})
+          {
+            t->set_initial_velocity([](const Point<2> &x) { return Tensor<1, 2>({0.1 * x[1], 0.}); });
+            t->set_initial_displacement(field);
+          }
+        for (const auto g : {Solver<2>::coarse, Solver<2>::fine})
+          {
+            check(s.n_active(g) == fresh.n_active(g) && s.n_fictitious(g) == fresh.n_fictitious(g),
+                  name + ": grid " + std::to_string(g) + ": active " + std::to_string(s.n_active(g)) +
+                    " / " + std::to_string(fresh.n_active(g)) + ", fictitious " +
+                    std::to_string(s.n_fictitious(g)) + " / " + std::to_string(fresh.n_fictitious(g)));
+            for (unsigned int i = 0; i < s.n_nodes(g); ++i)
+              if (s.is_active(g, i))
+                max_a = std::max(max_a, (s.acceleration(g, i) - fresh.acceleration(g, i)).norm());
+          }
+        for (unsigned int k = 0; k < 5; ++k)
+          {
+            s.advance();
+            fresh.advance();
+          }
+        for (const auto g : {Solver<2>::coarse, Solver<2>::fine})
+          for (unsigned int i = 0; i < s.n_nodes(g); ++i)
+            if (s.is_active(g, i) || fresh.is_active(g, i))
+              max_u = std::max(max_u, (s.displacement(g, i) - fresh.displacement(g, i)).norm());
+        check(max_a == 0. && max_u == 0. && max_acceleration(s).first > 0.,
+              name + ": refined on request = refined from the start: max |a - a'| = " + sci(max_a) +
+                ", after 5 steps max |u - u'| = " + sci(max_u) + " (bitwise 0)");
+      }
+  }
+
   // Patch tests: a rigid translation gives zero force on every node with
   // both interpolations (they reproduce constants); an affine field gives
   // zero force on every node with a complete family when the interpolation
@@ -544,9 +605,11 @@ main(int argc, char **argv)
         kw();
       else if (what == "bad_input")
         bad_input();
+      else if (what == "incremental_switch")
+        incremental_switch();
       else
         {
-          std::cerr << "usage: multiadapt_tests patch|mass_momentum|wave|kw|bad_input" << std::endl;
+          std::cerr << "usage: multiadapt_tests patch|mass_momentum|conservative_coupling|wave|kw|bad_input|incremental_switch" << std::endl;
           return 2;
         }
     }

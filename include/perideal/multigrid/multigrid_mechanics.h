@@ -325,6 +325,31 @@ namespace PeriDEAL
         /** True if every stencil neighbour of i exists. */
         bool
         interior(const unsigned int i) const;
+        /**
+         * Calls @p visit(j) for the stencil neighbours j of node i in the
+         * lattice (stencil order) until it returns true; returns whether it did.
+         */
+        template <typename Visitor>
+        bool
+        any_neighbour(const unsigned int i, const Visitor &visit) const
+        {
+          const auto ix = index(i);
+          const bool in = interior(i);
+          for (unsigned int k = 0; k < offset.size(); ++k)
+            {
+              if (!in)
+                {
+                  auto jx = ix;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    jx[d] += offset[k][d];
+                  if (!inside(jx))
+                    continue;
+                }
+              if (visit(static_cast<unsigned int>(i + linear_offset[k])))
+                return true;
+            }
+          return false;
+        }
       };
 
       /**
@@ -381,6 +406,16 @@ namespace PeriDEAL
         std::uint64_t filled = 0;
         /** False when the active set or the broken flags changed since the bits were built. */
         bool valid = false;
+        /** False when `state` must be rebuilt from the active flags (a switch updates it in place). */
+        bool state_valid = false;
+        /**
+         * False when all live bits must be rebuilt; else only those of the
+         * positions whose bonds reach [dirty_lo, dirty_hi), the box positions
+         * of the nodes a switch made (non-)evaluated. Per word: any live bit.
+         */
+        bool                       live_valid = false;
+        long                       dirty_lo = 0, dirty_hi = 0;
+        std::vector<std::uint64_t> any;
       };
 
       MechanicsParameters<dim> prm;
@@ -413,6 +448,21 @@ namespace PeriDEAL
       std::array<std::vector<double>, 2>       interp_weight;
       /** Coarse nodes to interpolate before the fine fictitious ones (inactive corners too). */
       std::vector<unsigned int> coarse_interpolated;
+      /**
+       * Runs of consecutive node indices within one lattice row (first
+       * node, length): their u, v, a and box positions are contiguous, so
+       * the Verlet updates and box fills vectorize. Per grid: the active
+       * nodes, the active and fictitious nodes, and (coarse) the active WLS
+       * nodes; with the active nodes that have a prescribed velocity.
+       */
+      std::array<std::vector<std::pair<unsigned int, unsigned int>>, 2> active_runs, filled_runs;
+      std::vector<std::pair<unsigned int, unsigned int>>                 wls_runs;
+      std::array<std::vector<unsigned int>, 2>                           prescribed_active;
+      /** The runs above from the node lists (after every change of the lists). */
+      void
+      update_runs();
+      /** Scratch flags per fine node (all 0 between uses). */
+      std::vector<std::uint8_t> fine_mark;
 
       void
       setup_lattice(const Grid g, const double dx);
@@ -436,6 +486,26 @@ namespace PeriDEAL
       /** Rebuild active/fictitious lists and interpolation rows from @p refined. */
       void
       update_node_sets();
+      /**
+       * The same sets after the coarse cells @p cells were refined, updated
+       * where they can change (within a stencil of the new fine nodes).
+       */
+      void
+      update_node_sets(const std::vector<unsigned int> &cells);
+      /** Fine node q (0 .. r^dim - 1, x fastest) of coarse cell @p cell. */
+      unsigned int
+      child(const unsigned int cell, const unsigned int q) const;
+      /** True if an active node of grid g has the inactive node i in its stencil. */
+      bool
+      has_active_neighbour(const Grid g, const unsigned int i) const;
+      /**
+       * Interpolation rows of the fictitious lists; rows of the nodes in
+       * @p old_fine / @p old_coarse (the lists the current rows belong to)
+       * are copied, since a row depends only on the node's position.
+       */
+      void
+      update_interpolation_rows(const std::vector<unsigned int> &old_fine,
+                                const std::vector<unsigned int> &old_coarse);
       /** IDW / d-linear sources in grid @p from for point @p x. */
       void
       interpolation_sources(const Grid                                   from,
@@ -461,7 +531,7 @@ namespace PeriDEAL
       void
       fill_box_positions(const Grid g);
       /** WLS displacements per coarse box position and the forces (hybrid). */
-      std::vector<double> wls_u, wls_f;
+      std::vector<double> wls_u;
       std::vector<long>   wls_box_offset;
       void
       apply_prescribed();
