@@ -443,7 +443,7 @@ namespace
     return prm;
   }
 
-  /** PML parameters (PML_SPONGE="sigma p": a sponge in the PML, scan only). */
+  /** Parameters of the PML (method pml). */
   WaveAbcParameters
   pml_parameters(const double sigma_max, const double w, const double p)
   {
@@ -452,12 +452,6 @@ namespace
     prm.pml_damping          = sigma_max;
     prm.pml_thickness        = w;
     prm.pml_exponent         = p;
-    if (const char *e = std::getenv("PML_SPONGE"))
-      {
-        std::istringstream in(e);
-        in >> prm.sponge_damping >> prm.sponge_exponent;
-        prm.sponge_thickness = w;
-      }
     return prm;
   }
 
@@ -1292,8 +1286,9 @@ namespace
   }
 
   // Scan of the PML parameters on E14 reduced (not a ctest: a tool for
-  // doc/design.md, session 8). PML_SCAN="w sigma p ratio inner; ..." with
-  // inner = 1: the PML starts at R - delta (inside the EBF disc), 0: at R.
+  // doc/design.md, session 8). PML_SCAN="w sigma p inner; ..." with
+  // inner = 1: the PML starts at R - delta (inside the EBF disc), 0: at R;
+  // PML_LONG=n also prints the total energy over n steps.
   void
   pml_scan()
   {
@@ -1310,18 +1305,18 @@ namespace
     const auto         ref       = simulate<2>(far, lp, mp, WaveTruncation::free, prm, u0, T, n_samples, inner);
     const double       norm0     = sum_squares(ref.fields[0]);
     const char        *env       = std::getenv("PML_SCAN");
-    std::istringstream in(env ? env : "1.5 2 2 0 0");
+    std::istringstream in(env ? env : "4.5 2 2 0");
     std::string        item;
     while (std::getline(in, item, ';'))
       {
         std::istringstream one(item);
-        double             w = 0., sigma = 0., p = 0., ratio = 0., inside = 0.;
-        if (!(one >> w >> sigma >> p >> ratio >> inside))
+        double             w = 0., sigma = 0., p = 0., inside = 0.;
+        if (!(one >> w >> sigma >> p >> inside))
           continue;
         BallDomain<2> near(Point<2>(), (inside > 0. ? R - lp.delta : R) + w);
         Timer         timer;
         const auto    h = simulate<2>(near, lp, mp, WaveTruncation::absorbing, pml_parameters(sigma, w, p), u0, T, n_samples, inner);
-        std::cout << "    w " << w << " sigma " << sigma << " p " << p << " ratio " << ratio << " start " << (inside > 0. ? R - lp.delta : R) << " (" << sci(timer.cpu_time()) << " s):";
+        std::cout << "    w " << w << " sigma " << sigma << " p " << p << " start " << (inside > 0. ? R - lp.delta : R) << " (" << sci(timer.cpu_time()) << " s):";
         for (unsigned int s = 1; s <= n_samples; ++s)
           std::cout << " " << sci(field_difference(h.fields[s], ref.fields[s], lp.dx) / norm0);
         std::cout << " | dE " << sci(std::abs(h.energy.back() - ref.energy.back()) / ref.energy[0]) << " maxinc " << sci(max_energy_increase(h.total_energy)) << std::endl;
@@ -1338,13 +1333,6 @@ namespace
                   pd.advance();
                 std::cout << "      t " << pd.time() << " E/E0 " << sci(pd.energy(all) / e0) << std::endl;
               }
-          }
-        if (std::getenv("PML_RADIUS"))
-          {
-            unsigned int         n_up = 0;
-            std::complex<double> dom;
-            const double rho = radius_2d(std::atof(std::getenv("PML_RADIUS")) + w, pml_parameters(sigma, w, p), 0.5, 3, &n_up, nullptr, &dom);
-            std::cout << "      rho - 1 = " << sci(rho - 1.) << " (" << n_up << " > 1 + 1e-8), angle " << std::arg(dom) << std::endl;
           }
       }
   }
