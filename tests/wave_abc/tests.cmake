@@ -1,6 +1,6 @@
 perideal_add_test_program(wave_abc_tests ${CMAKE_CURRENT_LIST_DIR}/wave_abc_tests.cc)
 
-foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge)
+foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS unit)
 endforeach()
 foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
@@ -8,7 +8,7 @@ foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
 endforeach()
 # E12c at the source's size (150,000 steps) and the EBF part of the
 # semi-discrete analysis (two dense 2D eigenproblems); the sponge over 1e6 steps.
-foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long)
+foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
 perideal_add_test(NAME wave_abc.pd_2d_ranks.np2 NPROCS 2

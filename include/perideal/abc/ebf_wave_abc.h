@@ -128,6 +128,25 @@ namespace PeriDEAL
       double sponge_thickness = 0.;
       /** Exponent p of the sponge profile. */
       double sponge_exponent = 2.;
+      /**
+       * PD, method "pml": largest damping rate sigma_max of the perfectly
+       * matched layer (doc/design.md, session 8): complex stretching of the
+       * normal coordinate, x_n -> x_n + (i/omega) Sigma(x_n), applied to the
+       * nonlocal operator bond by bond. The normal part of a bond (weight
+       * g = (n . xi/|xi|)^2, n: outward normal) has its difference u_j - u_i
+       * divided by
+       * s_ij = 1 + i sigma_ij/omega (sigma_ij: the mean of sigma along the
+       * bond, (Sigma_j - Sigma_i)/(rho_j - rho_i)) and the sum over the bonds
+       * by s_i = 1 + i sigma_i/omega; in time both divisions are exponential
+       * memory variables (one per bond of the nodes within w + delta of the
+       * boundary, one per node). sigma(rho) = sigma_max (rho/w)^p at the
+       * distance rho = w - depth into the PML. Nothing is overwritten.
+       */
+      double pml_damping = 0.;
+      /** PML width w (the outermost w of the near field; >= 2 dx). */
+      double pml_thickness = 0.;
+      /** Exponent p of the PML profile (>= 1). */
+      double pml_exponent = 2.;
 
       static void
       declare_parameters(ParameterHandler &prm);
@@ -348,7 +367,9 @@ namespace PeriDEAL
        * nothing is overwritten, the free PD near field is damped near its
        * boundary; energy-stable by construction.
        */
-      sponge
+      sponge,
+      /** Only the split-field PML of WaveAbcParameters (method "pml"). */
+      pml
     };
 
     /**
@@ -481,6 +502,13 @@ namespace PeriDEAL
       /** Lu = L u (u with current ghosts), minus the broken bonds. */
       void
       apply_operator();
+      /**
+       * PML: adds the stretching correction -sum_j g w m_ij - n_i to Lu of
+       * the PML band, first advancing the memories to the current u if
+       * @p update.
+       */
+      void
+      pml_correction(const bool update);
 
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
@@ -493,6 +521,14 @@ namespace PeriDEAL
       std::vector<double>                     damping, v_half, u_prev;
       /** Broken bonds: owned row i, local column j, kernel weight. */
       std::vector<std::tuple<unsigned int, unsigned int, double>> broken;
+      /**
+       * PML (method "pml"): the band nodes (depth < w + delta), their bonds
+       * (CSR: column, g k, exp(-sigma_ij dt), bond memory m_ij), the node
+       * factor exp(-sigma_i dt) and node memory n_i.
+       */
+      std::vector<unsigned int>               pml_nodes, pml_start, pml_col;
+      std::vector<double>                     pml_weight, pml_bond_decay, pml_bond_memory;
+      std::vector<double>                     pml_node_decay, pml_node_memory;
       double                                  dt = 0., t = 0., d = 0.;
       bool                                    absorbing = false;
     };
