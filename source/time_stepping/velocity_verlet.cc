@@ -436,28 +436,34 @@ namespace PeriDEAL
     // ascending). Held nodes are loaded, get their velocity, and then the
     // same kick and drift. Positions without a local node stay zero in every
     // array, and box_b is zero unless there is a body force.
+    // Raw pointers: through the vectors, every store would reload them.
     const double h0 = 0.5 * dt, tau0 = dt;
-    for (std::size_t i = 0; i < n_local; ++i)
+    for (unsigned int d = 0; d < dim; ++d)
       {
-        const std::size_t L      = pos[i];
-        const bool        owned  = i < n_owned;
-        const bool        moving = !owned || box_kind[L] == 2;
-        for (unsigned int d = 0; d < dim; ++d)
+        const double *__restrict un = displacement[d].begin();
+        const double *__restrict vn = velocity[d].begin();
+        const double *__restrict an = acceleration[d].begin();
+        const double *__restrict x  = box_x.data() + d * N;
+        const std::uint8_t *__restrict kind = box_kind.data();
+        double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+        double *__restrict p = box_p.data() + d * N, *__restrict f = box_f.data() + d * N;
+        for (std::size_t i = 0; i < n_local; ++i)
           {
-            const std::size_t k = d * N + L;
-            double            u = displacement[d].local_element(i);
-            double            v = owned ? velocity[d].local_element(i) : 0.;
-            const double      a = owned ? acceleration[d].local_element(i) : 0.;
-            if (moving)
+            const std::size_t L  = pos[i];
+            const bool        ow = i < n_owned;
+            double            ui = un[i];
+            double            vi = ow ? vn[i] : 0.;
+            const double      ai = ow ? an[i] : 0.;
+            if (!ow || kind[L] == 2)
               {
-                v += h0 * a;
-                u += tau0 * v;
-                box_p[k] = box_x[k] + u;
+                vi += h0 * ai;
+                ui += tau0 * vi;
+                p[L] = x[L] + ui;
               }
             else
-              box_f[k] = a;
-            box_u[k] = u;
-            box_v[k] = v;
+              f[L] = ai;
+            u[L] = ui;
+            v[L] = vi;
           }
       }
     if (has_body || box_b_nonzero)
@@ -568,23 +574,23 @@ namespace PeriDEAL
         ++n_steps;
       }
 
-    // Back to the node vectors (a as update_accelerations() sets it), one
-    // pass in node order.
-    for (std::size_t i = 0; i < n_local; ++i)
+    // Back to the node vectors (a as update_accelerations() sets it).
+    for (unsigned int d = 0; d < dim; ++d)
       {
-        const std::size_t L    = pos[i];
-        const bool        held = i < n_owned && box_kind[L] == 1;
-        for (unsigned int d = 0; d < dim; ++d)
+        const double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+        const double *__restrict f    = box_f.data() + d * N;
+        const double *__restrict b    = body_force[d].begin();
+        const std::uint8_t *__restrict kind = box_kind.data();
+        double *__restrict un = displacement[d].begin(), *__restrict vn = velocity[d].begin();
+        double *__restrict fn = force[d].begin(), *__restrict an = acceleration[d].begin();
+        for (std::size_t i = 0; i < n_local; ++i)
+          un[i] = u[pos[i]];
+        for (unsigned int i = 0; i < n_owned; ++i)
           {
-            const std::size_t k = d * N + L;
-            displacement[d].local_element(i) = box_u[k];
-            if (i < n_owned)
-              {
-                velocity[d].local_element(i) = box_v[k];
-                force[d].local_element(i)    = box_f[k];
-                acceleration[d].local_element(i) =
-                  held ? 0. : inv_rho * (box_f[k] + body_force[d].local_element(i));
-              }
+            const std::size_t L = pos[i];
+            vn[i]               = v[L];
+            fn[i]               = f[L];
+            an[i]               = kind[L] == 1 ? 0. : inv_rho * (f[L] + b[i]);
           }
       }
   }
