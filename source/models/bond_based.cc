@@ -986,8 +986,8 @@ namespace PeriDEAL
         const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
         const auto pass = [&](auto no, const unsigned int *hs) {
           internal::LatticeSweep::sweep_offsets<dim, decltype(no)::value>(
-            p, R, a, {sweep_live.data(), 1, sweep_bit_row, sweep_bit_slot.data()}, N, C, c0, nullptr, n / 8,
-            sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
+            p, R, a, {sweep_live.data(), 1, sweep_bit_row, sweep_bit_slot.data()}, N, C, c0,
+            nullptr, n / 8, sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
         };
         for (unsigned int h = 0; h < G; ++h)
           {

@@ -184,7 +184,7 @@ namespace PeriDEAL
           }
         for (int q = 0; q < NO; ++q)
           {
-            bq[q]            = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
+            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
             oq[q]            = o[hs[q]];
             const __m512d vr = _mm512_set1_pd(r[hs[q]]);
             const __m512d t  = _mm512_add_pd(vr, _mm512_mul_pd(_mm512_set1_pd(s0), vr));
