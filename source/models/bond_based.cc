@@ -314,6 +314,26 @@ namespace PeriDEAL
   {
     check_parameter(k >= 1 && k <= 4, "Lattice sweep offsets per pass", k, "1, 2, 3 or 4");
     sweep_offsets_per_pass = k;
+    set_sweep_bit_slots();
+  }
+
+  template <int dim>
+  void
+  BondBasedOperator<dim>::set_sweep_bit_slots()
+  {
+    // The K offsets h, h + G, ... of a pass get adjacent slots K h, ...,
+    // K h + K - 1 (G = H / K), the remainder its own index; the byte row of
+    // a group has H slots rounded up to a multiple of 8.
+    const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
+    std::vector<unsigned int> slot(H);
+    for (unsigned int h = 0; h < H; ++h)
+      slot[h] = h < K * G ? K * (h % G) + h / G : h;
+    if (slot != sweep_bit_slot)
+      {
+        sweep_bit_slot   = slot;
+        sweep_bits_valid = false;
+      }
+    sweep_bit_row = (H + 7) / 8 * 8;
   }
 
   template <int dim>
@@ -431,6 +451,7 @@ namespace PeriDEAL
     // same), which keeps the 2D summation order of the two-grid solver's
     // copy of the sweep.
     sweep_offsets_per_pass = dim == 3 ? 4 : 2;
+    set_sweep_bit_slots();
     sweep_n_box   = n_box;
     sweep_n_bytes = (sweep_n_box + 7) / 8;
     // Padding: the neighbour streams read up to the largest offset plus one
@@ -451,7 +472,7 @@ namespace PeriDEAL
   {
     const auto        &nb     = disc.neighborhood;
     const unsigned int centre = centre_index();
-    sweep_live.assign(sweep_offset.size() * sweep_n_bytes, 0);
+    sweep_live.assign(sweep_bit_row * sweep_n_bytes, 0);
     // The lower end of a bond (from which its offset is positive) and its
     // offset; the bit is set by either owned copy and cleared if either
     // copy is broken.
@@ -459,7 +480,7 @@ namespace PeriDEAL
       const unsigned int q = box_index(i, b);
       const unsigned int h = sweep_half_of_box[q];
       const std::uint32_t L = q > centre ? sweep_position[i] : sweep_position[nb.col[b]];
-      byte = h * sweep_n_bytes + L / 8;
+      byte = sweep_bit_slot[h] + std::size_t(L / 8) * sweep_bit_row;
       return std::uint8_t(1u << (L % 8));
     };
     for (int pass = 0; pass < 2; ++pass)
@@ -965,8 +986,8 @@ namespace PeriDEAL
         const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
         const auto pass = [&](auto no, const unsigned int *hs) {
           internal::LatticeSweep::sweep_offsets<dim, decltype(no)::value>(
-            p, R, a, sweep_live.data(), sweep_n_bytes, N, C, c0, nullptr, n / 8,
-            sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
+            p, R, a, {sweep_live.data(), 1, sweep_bit_row, sweep_bit_slot.data()}, N, C, c0,
+            nullptr, n / 8, sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
         };
         for (unsigned int h = 0; h < G; ++h)
           {

@@ -1105,16 +1105,16 @@ namespace PeriDEAL
               for (unsigned int h = 0; h < n_pairs; ++h)
                 {
                   const unsigned int hs[2] = {h, h + n_pairs};
-                  sweep_offsets<dim, 2>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
-                                        n_groups,
+                  sweep_offsets<dim, 2>(B.p.data(), R, acc, {live, B.n_bytes, 1, nullptr}, N,
+                                        C, c0, groups, n_groups,
                                         B.offset.data(), hs, B.coefficient.data(),
                                         B.length.data(), s_break, B.newly_broken);
                 }
               if (H % 2)
                 {
                   const unsigned int hs[1] = {H - 1};
-                  sweep_offsets<dim, 1>(B.p.data(), R, acc, live, B.n_bytes, N, C, c0, groups,
-                                        n_groups,
+                  sweep_offsets<dim, 1>(B.p.data(), R, acc, {live, B.n_bytes, 1, nullptr}, N,
+                                        C, c0, groups, n_groups,
                                         B.offset.data(), hs, B.coefficient.data(),
                                         B.length.data(), s_break, B.newly_broken);
                 }

@@ -300,6 +300,7 @@ namespace PeriDEAL
     apply_prescribed_velocities(t);
     apply_prescribed_displacements(t, false);
     update_accelerations();
+    allocate_box();
   }
 
   template <int dim>
@@ -311,6 +312,7 @@ namespace PeriDEAL
     if (body_force_function)
       body_force_function(t, body_force);
     update_accelerations();
+    allocate_box();
   }
 
   template <int dim>
@@ -370,24 +372,13 @@ namespace PeriDEAL
   {
     BondBasedOperator<dim>           &op      = *sweep_model;
     const std::size_t                 N       = op.lattice_sweep_stride();
-    const std::size_t                 E       = op.lattice_sweep_extent();
     const std::vector<std::uint32_t> &pos     = op.lattice_sweep_positions();
     const unsigned int                n_owned = disc.n_owned();
     const std::size_t                 n_local = disc.position.size();
     const double                      inv_rho = 1. / rho;
     const bool parallel = Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1;
 
-    // Load the node vectors into the box. Positions without a local node
-    // stay zero in every array (no pass writes anything else there).
-    if (box_u.size() != dim * N)
-      {
-        for (std::vector<double> *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
-          b->assign(dim * N, 0.);
-        const Point<dim> xc = op.deformation_origin();
-        for (unsigned int d = 0; d < dim; ++d)
-          for (std::size_t i = 0; i < n_local; ++i)
-            box_x[d * N + pos[i]] = disc.position[i][d] - xc[d];
-      }
+    allocate_box();
     box_kind.assign(N, 0);
     for (unsigned int i = 0; i < n_owned; ++i)
       box_kind[pos[i]] = is_held(i) ? 1 : 2;
@@ -399,26 +390,6 @@ namespace PeriDEAL
     for (unsigned int i = 0; i < n_owned; ++i)
       if (prescribed_set[i] >= 0)
         velocity_nodes.push_back(i);
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        double *u = box_u.data() + d * N, *p = box_p.data() + d * N;
-        const double *x = box_x.data() + d * N;
-        for (std::size_t i = 0; i < n_local; ++i)
-          {
-            u[pos[i]] = displacement[d].local_element(i);
-            p[pos[i]] = x[pos[i]] + u[pos[i]];
-          }
-        // box_f holds a^n for the first half-kick, F after the last step.
-        double *v = box_v.data() + d * N, *f = box_f.data() + d * N, *b = box_b.data() + d * N;
-        for (std::size_t i = n_owned; i < n_local; ++i)
-          v[pos[i]] = f[pos[i]] = b[pos[i]] = 0.;
-        for (unsigned int i = 0; i < n_owned; ++i)
-          {
-            v[pos[i]] = velocity[d].local_element(i);
-            f[pos[i]] = acceleration[d].local_element(i);
-            b[pos[i]] = body_force[d].local_element(i);
-          }
-      }
 
     // Held nodes before (at time t of the step) and after the drift, as
     // in advance().
@@ -459,23 +430,60 @@ namespace PeriDEAL
         }
     };
 
-    // The first half-kick and drift with the stored a^n (zero at held and
-    // non-owned positions).
-    held_before_drift(t);
+    // Load the node vectors into the box, fused with the first half-kick and
+    // drift with the stored a^n (0 at held nodes) of the free nodes and the
+    // ghosts (v = a = 0): one pass in node order (box positions nearly
+    // ascending). Held nodes are loaded, get their velocity, and then the
+    // same kick and drift. Positions without a local node stay zero in every
+    // array, and box_b is zero unless there is a body force.
+    // Raw pointers: through the vectors, every store would reload them.
+    const double h0 = 0.5 * dt, tau0 = dt;
     for (unsigned int d = 0; d < dim; ++d)
       {
+        const double *__restrict un = displacement[d].begin();
+        const double *__restrict vn = velocity[d].begin();
+        const double *__restrict an = acceleration[d].begin();
+        const double *__restrict x  = box_x.data() + d * N;
+        const std::uint8_t *__restrict kind = box_kind.data();
         double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
-        double *__restrict p       = box_p.data() + d * N;
-        const double *__restrict f = box_f.data() + d * N, *__restrict x = box_x.data() + d * N;
-        const double h = 0.5 * dt, tau = dt;
-#pragma omp simd
-        for (std::size_t L = 0; L < E; ++L)
+        double *__restrict p = box_p.data() + d * N, *__restrict f = box_f.data() + d * N;
+        for (std::size_t i = 0; i < n_local; ++i)
           {
-            v[L] += h * f[L];
-            u[L] += tau * v[L];
-            p[L] = x[L] + u[L];
+            const std::size_t L  = pos[i];
+            const bool        ow = i < n_owned;
+            double            ui = un[i];
+            double            vi = ow ? vn[i] : 0.;
+            const double      ai = ow ? an[i] : 0.;
+            if (!ow || kind[L] == 2)
+              {
+                vi += h0 * ai;
+                ui += tau0 * vi;
+                p[L] = x[L] + ui;
+              }
+            else
+              f[L] = ai;
+            u[L] = ui;
+            v[L] = vi;
           }
       }
+    if (has_body || box_b_nonzero)
+      for (unsigned int d = 0; d < dim; ++d)
+        for (unsigned int i = 0; i < n_owned; ++i)
+          box_b[d * N + pos[i]] = body_force[d].local_element(i);
+    box_b_nonzero = has_body;
+    held_before_drift(t);
+    const auto held_drift = [&](const unsigned int i) {
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const std::size_t k = d * N + pos[i];
+          box_v[k] += h0 * box_f[k];
+          box_u[k] += tau0 * box_v[k];
+          box_p[k] = box_x[k] + box_u[k];
+        }
+    };
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (box_kind[pos[i]] == 1)
+        held_drift(i);
 
     // Per chunk of final forces of step s: the second half-kick with
     // a = (F + b) / rho (0 at held nodes), then, unless s is the last step,
@@ -569,17 +577,42 @@ namespace PeriDEAL
     // Back to the node vectors (a as update_accelerations() sets it).
     for (unsigned int d = 0; d < dim; ++d)
       {
+        const double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+        const double *__restrict f    = box_f.data() + d * N;
+        const double *__restrict b    = body_force[d].begin();
+        const std::uint8_t *__restrict kind = box_kind.data();
+        double *__restrict un = displacement[d].begin(), *__restrict vn = velocity[d].begin();
+        double *__restrict fn = force[d].begin(), *__restrict an = acceleration[d].begin();
         for (std::size_t i = 0; i < n_local; ++i)
-          displacement[d].local_element(i) = box_u[d * N + pos[i]];
+          un[i] = u[pos[i]];
         for (unsigned int i = 0; i < n_owned; ++i)
           {
-            const std::size_t L         = d * N + pos[i];
-            velocity[d].local_element(i) = box_v[L];
-            force[d].local_element(i)    = box_f[L];
-            acceleration[d].local_element(i) =
-              is_held(i) ? 0. : inv_rho * (box_f[L] + body_force[d].local_element(i));
+            const std::size_t L = pos[i];
+            vn[i]               = v[L];
+            fn[i]               = f[L];
+            an[i]               = kind[L] == 1 ? 0. : inv_rho * (f[L] + b[i]);
           }
       }
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::allocate_box()
+  {
+    if (!uses_box_state())
+      return;
+    const BondBasedOperator<dim> &op = *sweep_model;
+    const std::size_t             N  = op.lattice_sweep_stride();
+    if (box_u.size() == dim * N)
+      return;
+    for (std::vector<double> *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
+      b->assign(dim * N, 0.);
+    box_b_nonzero                     = false;
+    const std::vector<std::uint32_t> &pos = op.lattice_sweep_positions();
+    const Point<dim>                  xc  = op.deformation_origin();
+    for (unsigned int d = 0; d < dim; ++d)
+      for (std::size_t i = 0; i < disc.position.size(); ++i)
+        box_x[d * N + pos[i]] = disc.position[i][d] - xc[d];
   }
 
   template <int dim>

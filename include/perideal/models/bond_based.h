@@ -449,8 +449,18 @@ namespace PeriDEAL
     /** Box position of each local node, local node of each box position (-1: none). */
     std::vector<std::uint32_t> sweep_position;
     std::vector<std::int32_t>  sweep_node;
-    /** Bit (h, L): bond (L, L + offset h) exists in an owned row and is not broken. */
+    /**
+     * Bit (h, L): bond (L, L + offset h) exists in an owned row and is not
+     * broken; bit L % 8 of byte sweep_bit_slot[h] + (L / 8) sweep_bit_row
+     * (the bytes of one group of eight positions together: a chunk's bits
+     * are one sequential stream, and a pass's offsets are adjacent).
+     */
     std::vector<std::uint8_t> sweep_live;
+    std::vector<unsigned int> sweep_bit_slot;
+    std::size_t               sweep_bit_row = 0;
+    /** Bit slots of the offsets for the current offsets per pass (invalidates the bits). */
+    void
+    set_sweep_bit_slots();
     /** Deformed positions and reactions per box position, dim arrays of sweep_n_alloc. */
     std::vector<double> sweep_p, sweep_reaction;
     /** Scratch: (offset, box position) of the bonds broken in this call. */

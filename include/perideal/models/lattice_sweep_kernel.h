@@ -53,6 +53,23 @@ namespace PeriDEAL
       }
 
       /**
+       * The live bits of a lattice sweep: bit L % 8 of byte
+       * live[slot(h) * slot_stride + (L / 8) * group_stride] is set if bond
+       * (L, L + o_h) exists and is not broken; slot(h) = slot[h], or h if
+       * @p slot is null. One bit array per offset is {live, n_bytes, 1,
+       * nullptr}; the operator's layout puts the bytes of all offsets of a
+       * group of eight positions next to each other (slot_stride 1), so that
+       * a chunk's bits are one sequential stream.
+       */
+      struct LiveBits
+      {
+        std::uint8_t       *live;
+        std::size_t         slot_stride;
+        std::size_t         group_stride;
+        const unsigned int *slot;
+      };
+
+      /**
        * The PMB bond of eight lanes given l2 = |y|^2, the stiffnesses kb,
        * kr = kb rb (rb the lengths) and t2 = (rb + s0 rb)^2: sets brk to the
        * alive lanes with l > (1 + s0) r, i.e. l2 > t2 (2.34), and returns
@@ -113,7 +130,7 @@ namespace PeriDEAL
        * multiple of 8): the groups c0 + 8 g for g = groups[0 .. n_groups)
        * (the chunk's groups with a live bit), or for g = 0 .. n_groups - 1
        * if @p groups is null. Bond (L, L + o_q) for every live bit
-       * (hs[q], L) of the bit array @p live (n_bytes bytes per offset). p and
+       * (hs[q], L) of the bit array @p bits (see LiveBits). p and
        * reaction are dim arrays of stride N over the box positions; the
        * force on L is accumulated in acc (dim arrays of stride C, indexed
        * from c0), the reaction on L + o in reaction (F = acc - reaction).
@@ -132,8 +149,7 @@ namespace PeriDEAL
       sweep_offsets(const double        *p,
                     double              *reaction,
                     double              *acc,
-                    std::uint8_t        *live,
-                    const std::size_t    n_bytes,
+                    const LiveBits      &bits,
                     const std::size_t    N,
                     const unsigned int   C,
                     const std::size_t    c0,
@@ -153,7 +169,8 @@ namespace PeriDEAL
         // registers, and their spills cost 6-7 % (doc/benchmarks.md,
         // session 7). The empty asm keeps GCC from hoisting base + offset
         // out of the loop again. Per offset: k, k r and (r + s0 r)^2.
-        std::uint8_t *const B = live + c0 / 8;
+        const std::size_t   gs = bits.group_stride;
+        std::uint8_t *const B  = bits.live + c0 / 8 * gs;
         std::size_t         bq[NO];
         std::int64_t        oq[NO];
         __m512d             vk[NO], vkr[NO], vt2[NO];
@@ -167,7 +184,7 @@ namespace PeriDEAL
           }
         for (int q = 0; q < NO; ++q)
           {
-            bq[q]            = hs[q] * n_bytes;
+            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
             oq[q]            = o[hs[q]];
             const __m512d vr = _mm512_set1_pd(r[hs[q]]);
             const __m512d t  = _mm512_add_pd(vr, _mm512_mul_pd(_mm512_set1_pd(s0), vr));
@@ -176,10 +193,11 @@ namespace PeriDEAL
             vt2[q]           = _mm512_mul_pd(t, t);
           }
         const auto group = [&](const std::size_t v) {
-          __mmask8 alive[NO], any = 0;
+          __mmask8      alive[NO], any = 0;
+          std::uint8_t *const Bv = B + v / 8 * gs;
 #  pragma GCC unroll 4
           for (int q = 0; q < NO; ++q)
-            any |= alive[q] = B[bq[q] + v / 8];
+            any |= alive[q] = Bv[bq[q]];
           if (any == 0)
             return;
           __m512d pi[dim], f[dim];
@@ -213,7 +231,7 @@ namespace PeriDEAL
                 }
               if (__builtin_expect(brk != 0, 0))
                 {
-                  B[bq[q] + v / 8] = alive[q] & ~brk;
+                  Bv[bq[q]] = alive[q] & ~brk;
                   for (unsigned int l = 0; l < 8; ++l)
                     if ((brk >> l) & 1u)
                       broken.emplace_back(hs[q], Position(c0 + v + l));

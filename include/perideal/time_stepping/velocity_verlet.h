@@ -291,6 +291,14 @@ namespace PeriDEAL
      */
     std::vector<double>       box_u, box_v, box_f, box_b, box_p, box_x;
     std::vector<std::uint8_t> box_kind;
+    /** box_b holds a body force (else it is zero). */
+    bool box_b_nonzero = false;
+    /**
+     * Allocate the box arrays and box_x once (from initialize() and
+     * restart(), so that the first advance(n) does not pay for it).
+     */
+    void
+    allocate_box();
     /** advance(n) in the box layout. */
     void
     advance_in_box(const unsigned int n);
