@@ -406,8 +406,11 @@ namespace PeriDEAL
       sweep_iL2.resize(n_f);
       sweep_B2.resize(n_f);
       sweep_class.resize(n_f);
+      sweep_kr.resize(n_f);
+      sweep_t2.resize(n_f);
       for (unsigned int f = 0; f < n_f; ++f)
         {
+          internal::LatticeSweep::pmb_offset_constants(sweep_r[f], sweep_k[f], s0, sweep_kr[f], sweep_t2[f]);
           sweep_mirror[f] = sweep_of_box[n_q - 1 - sweep_box[f]];
           // The thresholds of the CSR tables (the same expressions of r).
           const double r = sweep_r[f];
@@ -609,7 +612,9 @@ namespace PeriDEAL
     const auto        &nb = disc.neighborhood;
     const std::size_t  nv = sweep_n_vectors;
     const std::size_t  n_f = sweep_offset.size();
-    sweep_live.assign(n_f * nv, 0);
+    // One spare vector of zeros: the Omega_s runs read the bits of the
+    // vector after theirs.
+    sweep_live.assign(n_f * (nv + 1), 0);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const std::uint32_t L = sweep_position[i];
@@ -640,25 +645,36 @@ namespace PeriDEAL
     if (!sweep_on)
       return;
     // Lanes per vector of 8 box positions, and the vectors that have any.
-    standard_lanes.assign(sweep_n_vectors, 0);
     shared_lanes.assign(sweep_n_vectors, 0);
     wls_lanes.assign(sweep_n_vectors, 0);
     for (const unsigned int i : active_wls_rows)
       wls_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
-    for (const unsigned int i : standard_rows)
-      standard_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
     for (const unsigned int i : active_wls_rows)
       if (shared_row[i])
         shared_lanes[sweep_position[i] / 8] |= std::uint8_t(1u << (sweep_position[i] % 8));
-    standard_vectors.clear();
     shared_vectors.clear();
     for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
-      {
-        if (standard_lanes[v])
-          standard_vectors.push_back(v);
-        if (shared_lanes[v])
-          shared_vectors.push_back(v);
-      }
+      if (shared_lanes[v])
+        shared_vectors.push_back(v);
+    // Omega_s grows by switched families with ragged edges: aligned vectors
+    // fill 7.26 of 8 lanes at the end of KW dx = 0.5 (7.88 initially). Cover
+    // the Omega_s positions greedily (each run starts at the first position
+    // not yet covered; the fewest runs of eight): 7.61 lanes.
+    std::vector<std::uint32_t> positions;
+    positions.reserve(standard_rows.size());
+    for (const unsigned int i : standard_rows)
+      positions.push_back(sweep_position[i]);
+    std::sort(positions.begin(), positions.end());
+    standard_start.clear();
+    standard_start_lanes.clear();
+    for (const std::uint32_t L : positions)
+      if (standard_start.empty() || L >= standard_start.back() + 8)
+        {
+          standard_start.push_back(L);
+          standard_start_lanes.push_back(1);
+        }
+      else
+        standard_start_lanes.back() |= std::uint8_t(1u << (L - standard_start.back()));
   }
 
   template <int dim>
@@ -1025,29 +1041,36 @@ namespace PeriDEAL
     const std::size_t  N = sweep_n_alloc;
     const double      *p = sweep_p.data() + sweep_pad;
     const unsigned int n_f = sweep_offset.size();
+    // Local copies of the tables' addresses: the compiler reloaded them per
+    // offset (sweep_broken.emplace_back may alias the members).
+    const std::int64_t *offset = sweep_offset.data();
+    const double       *kb = sweep_k.data(), *kr = sweep_kr.data(), *t2 = sweep_t2.data();
     sweep_broken.clear();
-    for (const std::uint32_t v : standard_vectors)
+    for (std::size_t k = 0; k < standard_start.size(); ++k)
       {
-        const __mmask8    lanes = standard_lanes[v];
-        const std::size_t L0    = 8 * std::size_t(v);
-        __m512d           pi[dim], acc[dim];
+        // A run from L0 straddles the aligned vectors a and a + 1 (the bit
+        // array has one spare vector of zeros): their bits of offset f, as
+        // one 16-bit word, shifted by L0 % 8.
+        const std::uint32_t lanes = standard_start_lanes[k];
+        const std::size_t   L0    = standard_start[k];
+        const unsigned int  shift = L0 % 8;
+        __m512d             pi[dim], acc[dim];
         for (unsigned int d = 0; d < dim; ++d)
           {
             pi[d]  = _mm512_loadu_pd(p + d * N + L0);
             acc[d] = _mm512_setzero_pd();
           }
-        const std::uint8_t *bits = sweep_live.data() + std::size_t(v) * n_f;
+        const std::uint8_t *bits = sweep_live.data() + (L0 / 8) * n_f;
         for (unsigned int f = 0; f < n_f; ++f)
           {
-            const __mmask8 alive = bits[f] & lanes;
+            const __mmask8 alive = ((bits[f] | (std::uint32_t(bits[f + n_f]) << 8)) >> shift) & lanes;
             if (alive == 0)
               continue;
             __m512d       y[dim];
-            const __m512d l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
-            const __m512d rb = _mm512_set1_pd(sweep_r[f]);
+            const __m512d l2 = lane_bonds<dim>(p, N, L0, offset[f], pi, y);
             __mmask8      brk;
-            const __m512d scale = internal::LatticeSweep::pmb_bond_scale(l2, alive, rb, _mm512_set1_pd(sweep_k[f]),
-                                             _mm512_mul_pd(_mm512_set1_pd(s0), rb), brk);
+            const __m512d scale = internal::LatticeSweep::pmb_bond_scale_kr_unblended(
+              l2, alive, _mm512_set1_pd(kb[f]), _mm512_set1_pd(kr[f]), _mm512_set1_pd(t2[f]), brk);
             for (unsigned int d = 0; d < dim; ++d)
               acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);
             if (__builtin_expect(brk != 0, 0))

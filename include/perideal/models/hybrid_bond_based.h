@@ -443,11 +443,15 @@ namespace PeriDEAL
     std::array<int, dim>              sweep_lower{};
     std::array<std::int64_t, dim>     sweep_stride{};
     std::size_t                       sweep_pad = 0, sweep_n_vectors = 0, sweep_n_alloc = 0;
-    /** Per full offset f: linear offset, mirror offset, box index, k, r, thresholds, class. */
+    /**
+     * Per full offset f: linear offset, mirror offset, box index, k, r,
+     * thresholds, class; k r and (r + s0 r)^2 of the force (computed once,
+     * not per vector of the Omega_s rows).
+     */
     std::vector<std::int64_t>  sweep_offset;
     std::vector<unsigned int>  sweep_mirror, sweep_box;
     std::vector<int>           sweep_of_box;
-    std::vector<double>        sweep_k, sweep_r, sweep_L2, sweep_iL2, sweep_B2;
+    std::vector<double>        sweep_k, sweep_r, sweep_L2, sweep_iL2, sweep_B2, sweep_kr, sweep_t2;
     std::vector<std::uint8_t>  sweep_class;
     /** Per length class: its full offsets. */
     std::vector<std::vector<unsigned int>> class_offsets;
@@ -464,11 +468,18 @@ namespace PeriDEAL
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
     /**
-     * Per vector: lanes of owned Omega_s nodes, of shared-pattern WLS rows,
-     * of Omega_w rows; the length classes to test (bit k).
+     * Per vector: lanes of shared-pattern WLS rows, of Omega_w rows; the
+     * length classes to test (bit k).
      */
-    std::vector<std::uint8_t>  standard_lanes, shared_lanes, wls_lanes, test_lanes;
-    std::vector<std::uint32_t> standard_vectors, shared_vectors, test_vectors;
+    std::vector<std::uint8_t>  shared_lanes, wls_lanes, test_lanes;
+    std::vector<std::uint32_t> shared_vectors, test_vectors;
+    /**
+     * The Omega_s rows as runs of eight box positions starting anywhere
+     * (not only at multiples of 8, so a strip of Omega_s fills the lanes):
+     * first position and lanes of owned Omega_s nodes per run.
+     */
+    std::vector<std::uint32_t> standard_start;
+    std::vector<std::uint8_t>  standard_start_lanes;
     /** Bonds broken by the sweep: (full offset, box position of the row). */
     std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
     /** The shared WLS pattern: linear and lattice offsets, weights; per owned node: uses it. */

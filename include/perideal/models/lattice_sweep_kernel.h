@@ -88,6 +88,20 @@ namespace PeriDEAL
        * mask through a general register on the critical path.
        */
       inline __m512d
+      pmb_scale_of_length2(const __m512d  l2,
+                           const __mmask8 keep,
+                           const __m512d  kb,
+                           const __m512d  kr)
+      {
+        const __m512d y = _mm512_rsqrt14_pd(l2);
+        const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(l2, y), y, _mm512_set1_pd(1.));
+        __m512d       c = _mm512_fmadd_pd(e, _mm512_set1_pd(5. / 16.), _mm512_set1_pd(3. / 8.));
+        c               = _mm512_fmadd_pd(c, e, _mm512_set1_pd(0.5));
+        const __m512d inv = _mm512_fmadd_pd(_mm512_mul_pd(y, e), c, y);
+        return _mm512_maskz_fnmadd_pd(keep, kr, inv, kb);
+      }
+
+      inline __m512d
       pmb_bond_scale_kr(__m512d        l2,
                         const __mmask8 alive,
                         const __m512d  kb,
@@ -98,13 +112,42 @@ namespace PeriDEAL
         brk                 = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_GT_OQ);
         const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_LE_OQ);
         // Masked-off and broken lanes get l2 = 1 to keep inv finite.
-        l2              = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-        const __m512d y = _mm512_rsqrt14_pd(l2);
-        const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(l2, y), y, _mm512_set1_pd(1.));
-        __m512d       c = _mm512_fmadd_pd(e, _mm512_set1_pd(5. / 16.), _mm512_set1_pd(3. / 8.));
-        c               = _mm512_fmadd_pd(c, e, _mm512_set1_pd(0.5));
-        const __m512d inv = _mm512_fmadd_pd(_mm512_mul_pd(y, e), c, y);
-        return _mm512_maskz_fnmadd_pd(keep, kr, inv, kb);
+        l2 = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
+        return pmb_scale_of_length2(l2, keep, kb, kr);
+      }
+
+      /**
+       * pmb_bond_scale_kr() without the blend of the lanes outside @p alive
+       * (one instruction less per bond): those lanes may compute inf or NaN
+       * internally but return 0 like the others, and the alive lanes get
+       * bitwise the same scale. For loops in which a dead lane never traps
+       * (the default floating-point environment).
+       */
+      inline __m512d
+      pmb_bond_scale_kr_unblended(const __m512d  l2,
+                                  const __mmask8 alive,
+                                  const __m512d  kb,
+                                  const __m512d  kr,
+                                  const __m512d  t2,
+                                  __mmask8      &brk)
+      {
+        brk                 = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_GT_OQ);
+        const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_LE_OQ);
+        return pmb_scale_of_length2(l2, keep, kb, kr);
+      }
+
+      /**
+       * The per-offset constants of pmb_bond_scale_kr() for the length rb:
+       * kr = kb rb and t2 = (rb + s0 rb)^2, by the operations of
+       * pmb_bond_scale() and sweep_offsets() (bitwise the same values).
+       */
+      inline void
+      pmb_offset_constants(const double rb, const double kb, const double s0, double &kr, double &t2)
+      {
+        const __m512d vr = _mm512_set1_pd(rb);
+        const __m512d t  = _mm512_add_pd(vr, _mm512_mul_pd(_mm512_set1_pd(s0), vr));
+        kr               = _mm512_cvtsd_f64(_mm512_mul_pd(_mm512_set1_pd(kb), vr));
+        t2               = _mm512_cvtsd_f64(_mm512_mul_pd(t, t));
       }
 
       /**
