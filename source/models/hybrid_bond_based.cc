@@ -1069,7 +1069,7 @@ namespace PeriDEAL
             __m512d       y[dim];
             const __m512d l2 = lane_bonds<dim>(p, N, L0, offset[f], pi, y);
             __mmask8      brk;
-            const __m512d scale = internal::LatticeSweep::pmb_bond_scale_kr_unblended(
+            const __m512d scale = internal::LatticeSweep::pmb_bond_scale_kr<false>(
               l2, alive, _mm512_set1_pd(kb[f]), _mm512_set1_pd(kr[f]), _mm512_set1_pd(t2[f]), brk);
             for (unsigned int d = 0; d < dim; ++d)
               acc[d] = _mm512_fmadd_pd(scale, y[d], acc[d]);

@@ -101,6 +101,14 @@ namespace PeriDEAL
         return _mm512_maskz_fnmadd_pd(keep, kr, inv, kb);
       }
 
+      /**
+       * With @p blend_dead_lanes = false the lanes outside @p alive are not
+       * blended to l2 = 1 (one instruction less per bond): they may compute
+       * inf or NaN internally but return 0 like the others, and the alive
+       * lanes get bitwise the same scale. Only for loops in which a dead lane
+       * never traps (the default floating-point environment).
+       */
+      template <bool blend_dead_lanes = true>
       inline __m512d
       pmb_bond_scale_kr(__m512d        l2,
                         const __mmask8 alive,
@@ -112,27 +120,8 @@ namespace PeriDEAL
         brk                 = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_GT_OQ);
         const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_LE_OQ);
         // Masked-off and broken lanes get l2 = 1 to keep inv finite.
-        l2 = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
-        return pmb_scale_of_length2(l2, keep, kb, kr);
-      }
-
-      /**
-       * pmb_bond_scale_kr() without the blend of the lanes outside @p alive
-       * (one instruction less per bond): those lanes may compute inf or NaN
-       * internally but return 0 like the others, and the alive lanes get
-       * bitwise the same scale. For loops in which a dead lane never traps
-       * (the default floating-point environment).
-       */
-      inline __m512d
-      pmb_bond_scale_kr_unblended(const __m512d  l2,
-                                  const __mmask8 alive,
-                                  const __m512d  kb,
-                                  const __m512d  kr,
-                                  const __m512d  t2,
-                                  __mmask8      &brk)
-      {
-        brk                 = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_GT_OQ);
-        const __mmask8 keep = _mm512_mask_cmp_pd_mask(alive, l2, t2, _CMP_LE_OQ);
+        if constexpr (blend_dead_lanes)
+          l2 = _mm512_mask_blend_pd(alive, _mm512_set1_pd(1.), l2);
         return pmb_scale_of_length2(l2, keep, kb, kr);
       }
 
