@@ -15,7 +15,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <set>
@@ -345,7 +344,10 @@ namespace PeriDEAL
       absorbing = absorbing_in;
       cloud_start.assign(1, 0);
       cloud_index.clear();
-      coefficients.clear();
+      vg_now.clear();
+      vg_old.clear();
+      vh_now.clear();
+      vh_old.clear();
       info.clear();
       stats = WaveCloudStatistics();
 
@@ -510,7 +512,11 @@ namespace PeriDEAL
               for (unsigned int q = 0; q < sel.size(); ++q)
                 {
                   const double c = -dt * chi * P(1, q) + (q == 0 ? 1. - dt * dispersion.damping : 0.);
-                  add_entry(cone[sel[q]].first, c, 0., c, 0.);
+                  cloud_index.push_back(cone[sel[q]].first);
+                  vg_now.push_back(c);
+                  vg_old.push_back(0.);
+                  vh_now.push_back(c);
+                  vh_old.push_back(0.);
                   ci.vmax_g = ci.vmax_h = std::max(ci.vmax_g, std::abs(c));
                   ci.row_sum_g += std::abs(c);
                 }
@@ -716,17 +722,19 @@ namespace PeriDEAL
             if (cf.first != ids[i])
               sorted_coeff.push_back(cf.second);
           for (const auto &cf : sorted_coeff)
-            add_entry(cf.first, cf.second[0], cf.second[1], cf.second[2], cf.second[3]);
+            {
+              cloud_index.push_back(cf.first);
+              vg_now.push_back(cf.second[0]);
+              vg_old.push_back(cf.second[1]);
+              vh_now.push_back(cf.second[2]);
+              vh_old.push_back(cf.second[3]);
+            }
           cloud_start.push_back(cloud_index.size());
         }
       all_cloud_points = cloud_index;
       std::sort(all_cloud_points.begin(), all_cloud_points.end());
       all_cloud_points.erase(std::unique(all_cloud_points.begin(), all_cloud_points.end()),
                              all_cloud_points.end());
-      cloud_slot.resize(cloud_index.size());
-      for (std::size_t c = 0; c < cloud_index.size(); ++c)
-        cloud_slot[c] = std::lower_bound(all_cloud_points.begin(), all_cloud_points.end(), cloud_index[c]) -
-                        all_cloud_points.begin();
       stats.n_absorbing = Utilities::MPI::sum<types::global_dof_index>(absorbing.size(), comm);
       stats.max_condition_number = Utilities::MPI::max(max_cond, comm);
       stats.max_update_norm      = Utilities::MPI::max(max_norm, comm);
@@ -738,27 +746,14 @@ namespace PeriDEAL
 
     template <int dim>
     void
-    EbfWaveAbc<dim>::add_entry(const unsigned int j,
-                               const double       g_now,
-                               const double       g_old,
-                               const double       h_now,
-                               const double       h_old)
-    {
-      cloud_index.push_back(j);
-      coefficients.insert(coefficients.end(), {g_now, h_now, g_old, h_old});
-    }
-
-    template <int dim>
-    void
     EbfWaveAbc<dim>::compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const
     {
       u_new.resize(absorbing.size());
-      const double *w = coefficients.data();
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
           double su = 0.;
           for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
-            su += w[4 * c] * u[cloud_index[c]] + w[4 * c + 2] * u_old[cloud_index[c]];
+            su += vg_now[c] * u[cloud_index[c]] + vg_old[c] * u_old[cloud_index[c]];
           u_new[a] = su;
         }
     }
@@ -774,51 +769,17 @@ namespace PeriDEAL
     {
       u_new.resize(absorbing.size());
       v_new.resize(absorbing.size());
-      const double *w = coefficients.data();
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
           double su = 0., sv = 0.;
           for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
             {
               const unsigned int j = cloud_index[c];
-              su += w[4 * c] * u[j] + w[4 * c + 2] * u_old[j];
-              sv += w[4 * c + 1] * v[j] + w[4 * c + 3] * v_old[j];
+              su += vg_now[c] * u[j] + vg_old[c] * u_old[j];
+              sv += vh_now[c] * v[j] + vh_old[c] * v_old[j];
             }
           u_new[a] = su;
           v_new[a] = sv;
-        }
-    }
-
-    template <int dim>
-    void
-    EbfWaveAbc<dim>::compute_packed(const double        *history,
-                                    std::vector<double> &u_new,
-                                    std::vector<double> &v_new) const
-    {
-      u_new.resize(absorbing.size());
-      v_new.resize(absorbing.size());
-      // u and v in the two lanes of one 16-byte vector: lane-wise the same
-      // operations in the same order as the scalar sums of compute().
-      using Pair               = double __attribute__((vector_size(16)));
-      const auto load          = [](const double *x) {
-        Pair p;
-        std::memcpy(&p, x, sizeof(Pair));
-        return p;
-      };
-      const double       *w    = coefficients.data();
-      const unsigned int *slot = cloud_slot.data();
-      for (unsigned int a = 0; a < absorbing.size(); ++a)
-        {
-          Pair               s   = {0., 0.};
-          const unsigned int end = cloud_start[a + 1];
-          for (unsigned int c = cloud_start[a]; c < end; ++c)
-            {
-              const double *h = history + 4 * std::size_t(slot[c]);
-              const double *wc = w + 4 * std::size_t(c);
-              s += load(wc) * load(h) + load(wc + 2) * load(h + 2);
-            }
-          u_new[a] = s[0];
-          v_new[a] = s[1];
         }
     }
 
@@ -916,7 +877,9 @@ namespace PeriDEAL
       apply_operator();
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         a.local_element(i) = Lu.local_element(i);
-      cloud_history.clear();
+      const unsigned int n_local = disc.n_owned() + disc.n_ghost();
+      u_old.assign(u.begin(), u.begin() + n_local);
+      v_old.assign(v.begin(), v.begin() + n_local);
 
       const bool sponge_only = boundary == WaveTruncation::sponge ||
                                (boundary == WaveTruncation::absorbing && prm_in.method == "sponge");
@@ -1022,16 +985,6 @@ namespace PeriDEAL
           excluded.push_back(-domain.signed_distance(p) < layer - 1e-8 * lattice.dx);
       abc.reinit(disc.position, ids, nodes, normals, *relation, dt, lattice.dx, prm,
                  disc.get_mpi_communicator(), excluded);
-      // The level n-1 of the first step is the initial state.
-      {
-        const std::vector<unsigned int> &c = abc.cloud_points();
-        cloud_history.resize(4 * c.size());
-        for (std::size_t q = 0; q < c.size(); ++q)
-          {
-            cloud_history[4 * q]     = u.local_element(c[q]);
-            cloud_history[4 * q + 1] = v.local_element(c[q]);
-          }
-      }
       // The local guards do not imply stability of the coupled recursion
       // (doc/design.md): check the global one-step map where affordable.
       const std::size_t state = 2 * std::size_t(disc.n_owned()) + 2 * abc.cloud_points().size();
@@ -1073,19 +1026,12 @@ namespace PeriDEAL
       // (4.82) from the levels n and n-1 (ghosts of u, v are current).
       if (absorbing)
         {
-          // One pass over the cloud points: shift the level n to n-1 and
-          // gather the new level n (u, v with current ghosts).
-          const std::vector<unsigned int> &c  = abc.cloud_points();
-          const double                    *uc = u.begin(), *vc = v.begin();
-          double                          *h  = cloud_history.data();
-          for (std::size_t q = 0; q < c.size(); ++q, h += 4)
+          abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
+          for (const unsigned int j : abc.cloud_points())
             {
-              h[2] = h[0];
-              h[3] = h[1];
-              h[0] = uc[c[q]];
-              h[1] = vc[c[q]];
+              u_old[j] = u.begin()[j];
+              v_old[j] = v.begin()[j];
             }
-          abc.compute_packed(cloud_history.data(), u_abc, v_abc);
         }
       const auto abc_end = clock::now();
       double    *uu = u.begin(), *vv = v.begin(), *aa = a.begin();
@@ -1140,7 +1086,7 @@ namespace PeriDEAL
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
       // Save the solver state.
       const Vector              u0 = u, v0 = v, a0 = a;
-      const std::vector<double> ch0 = cloud_history, up0 = u_prev, vh0 = v_half;
+      const std::vector<double> uo0 = u_old, vo0 = v_old, up0 = u_prev, vh0 = v_half;
       const std::vector<double> bm0 = pml_bond_memory, nm0 = pml_node_memory;
       const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
       const auto                set_state = [&](const std::vector<double> &x) {
@@ -1152,8 +1098,8 @@ namespace PeriDEAL
         if (absorbing)
           for (unsigned int q = 0; q < c.size(); ++q)
             {
-              cloud_history[4 * q]     = x[2 * n + q];
-              cloud_history[4 * q + 1] = x[2 * n + c.size() + q];
+              u_old[c[q]] = x[2 * n + q];
+              v_old[c[q]] = x[2 * n + c.size() + q];
             }
         std::copy(x.begin() + 2 * n + n_abc, x.begin() + 2 * n + n_abc + n_bond, pml_bond_memory.begin());
         std::copy(x.begin() + 2 * n + n_abc + n_bond, x.end(), pml_node_memory.begin());
@@ -1183,8 +1129,8 @@ namespace PeriDEAL
           if (absorbing)
             for (unsigned int q = 0; q < c.size(); ++q)
               {
-                column[2 * n + q]            = cloud_history[4 * q];
-                column[2 * n + c.size() + q] = cloud_history[4 * q + 1];
+                column[2 * n + q]            = u_old[c[q]];
+                column[2 * n + c.size() + q] = v_old[c[q]];
               }
           std::copy(pml_bond_memory.begin(), pml_bond_memory.end(), column + 2 * n + n_abc);
           std::copy(pml_node_memory.begin(), pml_node_memory.end(), column + 2 * n + n_abc + n_bond);
@@ -1192,7 +1138,8 @@ namespace PeriDEAL
       u     = u0;
       v     = v0;
       a     = a0;
-      cloud_history = ch0;
+      u_old  = uo0;
+      v_old  = vo0;
       u_prev = up0;
       v_half = vh0;
       pml_bond_memory = bm0;

@@ -307,16 +307,6 @@ namespace PeriDEAL
               std::vector<double> &u_new,
               std::vector<double> &v_new) const;
 
-      /**
-       * compute() on packed cloud data, for callers that keep the cloud
-       * history themselves (PdUnboundedWave): @p history holds four values
-       * per point q of cloud_points(), (u^n_q, v^n_q, u^{n-1}_q, v^{n-1}_q) at
-       * 4 q, so that each cloud entry reads one 32-byte record instead of
-       * four scattered arrays. Same sums in the same order as compute().
-       */
-      void
-      compute_packed(const double *history, std::vector<double> &u_new, std::vector<double> &v_new) const;
-
       /** Only u_new[a] = V_G . (u^n_j, u^{n-1}_j)_j (callers that derive v otherwise). */
       void
       compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const;
@@ -351,22 +341,9 @@ namespace PeriDEAL
       local_frame(const Tensor<1, dim> &outward_normal);
 
     private:
-      /**
-       * Add the cloud entry of local point @p j with the coefficients V_G and
-       * V_H of the levels n and n-1.
-       */
-      void
-      add_entry(const unsigned int j, const double g_now, const double g_old, const double h_now,
-                const double h_old);
-
       std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
-      /** Per cloud entry: the position of cloud_index in all_cloud_points (compute_packed()). */
-      std::vector<unsigned int> cloud_slot;
-      /**
-       * Per cloud entry, contiguous: V_G and V_H of level n, then of level
-       * n-1 (the order of the history records of compute_packed()).
-       */
-      std::vector<double> coefficients;
+      /** Per cloud entry: V_G and V_H for levels n and n-1. */
+      std::vector<double> vg_now, vg_old, vh_now, vh_old;
       std::vector<WaveCloudInfo> info;
       WaveCloudStatistics stats;
     };
@@ -538,14 +515,7 @@ namespace PeriDEAL
       std::unique_ptr<WaveDispersion<dim>>    relation;
       EbfWaveAbc<dim>                         abc;
       Vector                                  u, v, a, Lu;
-      std::vector<double>                     u_abc, v_abc;
-      /**
-       * The cloud values for compute_packed(), four per point of
-       * abc.cloud_points(): between steps the first two hold u^n, v^n (the
-       * level n-1 of the next step); advance() moves them to the last two
-       * and gathers the new level.
-       */
-      std::vector<double>                     cloud_history;
+      std::vector<double>                     u_old, v_old, u_abc, v_abc;
       std::vector<double>                     bond_kernel_weight;
       /** d + sigma(x_i) per owned node; v^{n-1/2} and u^{n-1} of the last step. */
       std::vector<double>                     damping, v_half, u_prev;
