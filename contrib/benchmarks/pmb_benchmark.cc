@@ -26,6 +26,10 @@
 //                    repeats, _min/_max keys their spread (a shared machine)
 //   --loop-only      stop after the timed loop (run-all.sh's interleaved
 //                    rounds against LAMMPS)
+//   --sync-every-call  the timed advance(n) calls convert the state into and
+//                    out of the sweep's box layout each (the default defers
+//                    the node vectors to one sync_node_vectors() at the end
+//                    of the timed loop, which is timed)
 //   --profile-steps S  only run S Verlet steps after setup (for profilers)
 //   --trace-steps S  only run S single Verlet steps, printing each one's CPU
 //                    time and the broken-bond fraction after it
@@ -80,6 +84,7 @@ namespace
     double            seconds       = 1.;
     unsigned int      repeats       = 1;
     bool              loop_only     = false;
+    bool              sync_every_call = false;
     unsigned int      profile_steps = 0;
     unsigned int      trace_steps   = 0;
     std::vector<unsigned int> chunks;
@@ -226,7 +231,8 @@ namespace
     flush();
 
     // With `perf record -D -1 --control fifo:CTL,ACK`, PERIDEAL_PERF_CTL=CTL
-    // and PERIDEAL_PERF_ACK=ACK, only the steps below are recorded.
+    // and PERIDEAL_PERF_ACK=ACK, only the profiled or timed steps are
+    // recorded.
     const auto perf_control = [](const char *command) {
       const char *ctl = std::getenv("PERIDEAL_PERF_CTL");
       const char *ack = std::getenv("PERIDEAL_PERF_ACK");
@@ -313,9 +319,13 @@ namespace
         const double t_one = time_loop(comm, 1, [&] { verlet->advance(); }).wall;
         steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
       }
-    // The timed steps run as ten calls of advance(n) (a run between two
-    // outputs): with the lattice sweep the state stays in its box layout
-    // within a call (VelocityVerlet::advance(n)).
+    // The timed steps run as ten calls of advance(n) (runs between two
+    // points at which a driver checks something): with the lattice sweep
+    // the state stays in its box layout within a call
+    // (VelocityVerlet::advance(n)) and, with deferred node sync, between the
+    // calls; the final sync_node_vectors() (the node-ordered state, as
+    // LAMMPS has its state in its arrays after `run`) is part of the timed
+    // loop.
     const unsigned int calls = std::min(10u, std::max(steps, 1u));
     steps = calls * ((Utilities::MPI::max(steps, comm) + calls - 1) / calls);
     print("steps", steps);
@@ -332,7 +342,16 @@ namespace
             model  = model_ptr.get();
             verlet = verlet_ptr.get();
           }
-        const Timing t = time_loop(comm, calls, [&] { verlet->advance(steps / calls); });
+        verlet->set_deferred_node_sync(!opt.sync_every_call);
+        unsigned int call = 0;
+        perf_control("enable");
+        const Timing t = time_loop(comm, calls, [&] {
+          verlet->advance(steps / calls);
+          if (++call == calls)
+            verlet->sync_node_vectors();
+        });
+        perf_control("disable");
+        verlet->set_deferred_node_sync(false);
         t_step.wall    = std::min(t_step.wall, t.wall);
         t_step.cpu     = std::min(t_step.cpu, t.cpu);
         loop_wall.push_back(t.total);
@@ -352,6 +371,23 @@ namespace
     print("loop_bond_updates_per_cpu_second_min", bond_updates / *cpu_max);
     print("loop_bond_updates_per_cpu_second_max", bond_updates / *cpu_min);
     print("broken_bond_fraction", double(model->n_broken_bonds()) / bonds);
+    // FNV-1a of the bytes of u, v, a and the broken flags of rank 0 after
+    // the last repeat: equal for every code path that is bitwise the same
+    // (e.g. with and without --sync-every-call).
+    {
+      std::uint64_t hash = 1469598103934665603ull;
+      const auto    add  = [&](const void *data, const std::size_t n) {
+        for (std::size_t k = 0; k < n; ++k)
+          hash = (hash ^ static_cast<const unsigned char *>(data)[k]) * 1099511628211ull;
+      };
+      for (const auto *field : {&verlet->displacement, &verlet->velocity, &verlet->acceleration})
+        for (unsigned int d = 0; d < dim; ++d)
+          add((*field)[d].begin(), disc->n_owned() * sizeof(double));
+      add(model->broken().data(), model->broken().size());
+      if (rank == 0)
+        std::printf("%sfinal_state_hash: %016llx\n", prefix.c_str(),
+                    static_cast<unsigned long long>(hash));
+    }
     flush();
     if (opt.loop_only)
       return;
@@ -572,6 +608,8 @@ namespace
                            opt.repeats = std::max(1, std::stoi(next()));
                          else if (arg == "--loop-only")
                            opt.loop_only = true;
+                         else if (arg == "--sync-every-call")
+                           opt.sync_every_call = true;
                          else if (arg == "--trace-steps")
                            opt.trace_steps = std::stoi(next());
                          else if (arg == "--agreement")
