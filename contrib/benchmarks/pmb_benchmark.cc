@@ -18,6 +18,18 @@
 //   --dim D --m M --nodes N   a custom case
 //   --steps S        timed steps (0: enough for --seconds)
 //   --seconds T      target wall time of the timed loop (default 1)
+//   --repeats R      run the timed loop R times (default 1), each from a
+//                    fresh state (new operator and Verlet on the same
+//                    discretization, so no bond broken, u = 0, t = 0): with
+//                    --steps S every repeat times steps 1..S, as LAMMPS's
+//                    `run S` does. The loop keys are the medians over the
+//                    repeats, _min/_max keys their spread (a shared machine)
+//   --loop-only      stop after the timed loop (run-all.sh's interleaved
+//                    rounds against LAMMPS)
+//   --sync-every-call  the timed advance(n) calls convert the state into and
+//                    out of the sweep's box layout each (the default defers
+//                    the node vectors to one sync_node_vectors() at the end
+//                    of the timed loop, which is timed)
 //   --profile-steps S  only run S Verlet steps after setup (for profilers)
 //   --trace-steps S  only run S single Verlet steps, printing each one's CPU
 //                    time and the broken-bond fraction after it
@@ -46,6 +58,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -69,6 +82,9 @@ namespace
     std::vector<Case> cases;
     unsigned int      steps         = 0;
     double            seconds       = 1.;
+    unsigned int      repeats       = 1;
+    bool              loop_only     = false;
+    bool              sync_every_call = false;
     unsigned int      profile_steps = 0;
     unsigned int      trace_steps   = 0;
     std::vector<unsigned int> chunks;
@@ -151,20 +167,30 @@ namespace
     mp.plane_stress   = true;
     mp.linearized     = false;
     mp.critical_stretch = 1e-3;
-    BondBasedOperator<dim> model(*disc, mp);
-    const double           rho = 1.;
-    const double           dt  = 0.5 * model.critical_time_step(rho);
-    VelocityVerlet<dim>    verlet(model, rho, dt);
-    const double           t_setup = Utilities::MPI::max(MPI_Wtime() - t0, comm);
-
-    // Two halves pulled apart (see the header).
-    const double v0 = 4. * model.critical_stretch();
-    const double xc = 0.5 * (n_side - 1.);
-    for (unsigned int i = 0; i < disc->n_owned(); ++i)
-      verlet.velocity[0].local_element(i) = disc->position[i][0] > xc ? v0 : -v0;
-    verlet.initialize();
+    const double rho = 1.;
+    // The operator (which owns the broken flags) and the Verlet state are
+    // rebuilt for every repeat of the timed loop: fresh_state() gives the
+    // initial state of the problem, two halves pulled apart (see the header).
+    std::unique_ptr<BondBasedOperator<dim>> model_ptr;
+    std::unique_ptr<VelocityVerlet<dim>>    verlet_ptr;
+    double                                  dt = 0., v0 = 0.;
+    const double                            xc = 0.5 * (n_side - 1.);
+    const auto                              fresh_state = [&] {
+      verlet_ptr.reset();
+      model_ptr = std::make_unique<BondBasedOperator<dim>>(*disc, mp);
+      dt        = 0.5 * model_ptr->critical_time_step(rho);
+      v0        = 4. * model_ptr->critical_stretch();
+      verlet_ptr = std::make_unique<VelocityVerlet<dim>>(*model_ptr, rho, dt);
+      for (unsigned int i = 0; i < disc->n_owned(); ++i)
+        verlet_ptr->velocity[0].local_element(i) = disc->position[i][0] > xc ? v0 : -v0;
+      verlet_ptr->initialize();
+    };
+    fresh_state();
+    const double t_setup = Utilities::MPI::max(MPI_Wtime() - t0, comm);
 
     const auto   rss_after = rss_bytes();
+    BondBasedOperator<dim> *model  = model_ptr.get();
+    VelocityVerlet<dim>    *verlet = verlet_ptr.get();
     const auto  &nb        = disc->neighborhood;
     const double bonds     = double(disc->n_global_bonds());
     const double nodes     = double(disc->n_global());
@@ -197,15 +223,16 @@ namespace
     // Parameters a second code needs to run the same problem.
     print_exact("n_side", n_side);
     print_exact("delta", disc->parameters().delta);
-    print_exact("micromodulus", model.micromodulus());
-    print_exact("critical_stretch", model.critical_stretch());
+    print_exact("micromodulus", model->micromodulus());
+    print_exact("critical_stretch", model->critical_stretch());
     print_exact("density", rho);
     print_exact("dt", dt);
     print_exact("v0", v0);
     flush();
 
     // With `perf record -D -1 --control fifo:CTL,ACK`, PERIDEAL_PERF_CTL=CTL
-    // and PERIDEAL_PERF_ACK=ACK, only the steps below are recorded.
+    // and PERIDEAL_PERF_ACK=ACK, only the profiled or timed steps are
+    // recorded.
     const auto perf_control = [](const char *command) {
       const char *ctl = std::getenv("PERIDEAL_PERF_CTL");
       const char *ack = std::getenv("PERIDEAL_PERF_ACK");
@@ -227,28 +254,28 @@ namespace
     if (opt.profile_steps > 0)
       {
         perf_control("enable");
-        verlet.advance(opt.profile_steps);
+        verlet->advance(opt.profile_steps);
         perf_control("disable");
         return;
       }
-    if (!opt.chunks.empty() && model.uses_lattice_sweep())
+    if (!opt.chunks.empty() && model->uses_lattice_sweep())
       {
         // Sweep chunk sizes round robin (CPU time, median of 5 rounds),
         // after 10 steps (the first bonds have broken).
-        verlet.advance(10);
+        verlet->advance(10);
         typename BondBasedOperator<dim>::VectorField f;
-        model.initialize(f);
+        model->initialize(f);
         const unsigned int               reps = std::max(3., 2e8 / bonds);
         std::vector<std::vector<double>> cpu(opt.chunks.size());
         for (unsigned int round = 0; round < 5; ++round)
           for (std::size_t k = 0; k < opt.chunks.size(); ++k)
             {
               // c + K: chunk c, K offsets per pass (K < 8).
-              model.set_lattice_sweep_chunk(opt.chunks[k] / 8 * 8);
-              model.set_lattice_sweep_offsets_per_pass(opt.chunks[k] % 8 == 0 ? 2 : opt.chunks[k] % 8);
+              model->set_lattice_sweep_chunk(opt.chunks[k] / 8 * 8);
+              model->set_lattice_sweep_offsets_per_pass(opt.chunks[k] % 8 == 0 ? 2 : opt.chunks[k] % 8);
               const double c0 = thread_cpu_seconds();
               for (unsigned int r = 0; r < reps; ++r)
-                model.compute_forces(verlet.displacement, f);
+                model->compute_forces(verlet->displacement, f);
               cpu[k].push_back(thread_cpu_seconds() - c0);
             }
         for (std::size_t k = 0; k < opt.chunks.size(); ++k)
@@ -266,45 +293,109 @@ namespace
         for (unsigned int s = 0; s < opt.trace_steps; ++s)
           {
             const double c0 = thread_cpu_seconds();
-            verlet.advance();
+            verlet->advance();
             const double cpu = Utilities::MPI::sum(thread_cpu_seconds() - c0, comm);
             if (rank == 0)
               std::printf("%strace_step %u cpu %.4f rate %.4g broken_fraction %.5g\n",
                           prefix.c_str(), s + 1, cpu, bonds / cpu,
-                          double(model.n_broken_bonds()) / bonds);
+                          double(model->n_broken_bonds()) / bonds);
             flush();
           }
         return;
       }
 
-    // Warm-up step, which also calibrates the number of steps.
-    const double t_one = time_loop(comm, 1, [&] { verlet.advance(); }).wall;
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v.empty() ? 0. : 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
+    };
+    // Without --steps, a warm-up step calibrates the number of steps, and
+    // the first repeat continues from it (steps 2..S+1); with --steps S
+    // every repeat starts from the initial state and times steps 1..S,
+    // the steps of LAMMPS's timed loop (its setup, like initialize(), has
+    // computed the forces of step 0).
     unsigned int steps = opt.steps;
     if (steps == 0)
-      steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
-    // The timed steps run as ten calls of advance(n) (a run between two
-    // outputs): with the lattice sweep the state stays in its box layout
-    // within a call (VelocityVerlet::advance(n)).
+      {
+        const double t_one = time_loop(comm, 1, [&] { verlet->advance(); }).wall;
+        steps = std::max(3., std::min(1e5, std::ceil(opt.seconds / std::max(t_one, 1e-9))));
+      }
+    // The timed steps run as ten calls of advance(n) (runs between two
+    // points at which a driver checks something): with the lattice sweep
+    // the state stays in its box layout within a call
+    // (VelocityVerlet::advance(n)) and, with deferred node sync, between the
+    // calls; the final sync_node_vectors() (the node-ordered state, as
+    // LAMMPS has its state in its arrays after `run`) is part of the timed
+    // loop.
     const unsigned int calls = std::min(10u, std::max(steps, 1u));
     steps = calls * ((Utilities::MPI::max(steps, comm) + calls - 1) / calls);
     print("steps", steps);
+    print("repeats", opt.repeats);
 
-    const double bond_updates = bonds * steps;
-    const Timing t_step = time_loop(comm, calls, [&] { verlet.advance(steps / calls); });
+    const double        bond_updates = bonds * steps;
+    Timing              t_step{1e300, 1e300, 0., 0.}; // fastest call over all repeats
+    std::vector<double> loop_wall, loop_cpu;
+    for (unsigned int r = 0; r < std::max(opt.repeats, 1u); ++r)
+      {
+        if (verlet->step() > 0 && (r > 0 || opt.steps > 0))
+          {
+            fresh_state();
+            model  = model_ptr.get();
+            verlet = verlet_ptr.get();
+          }
+        verlet->set_deferred_node_sync(!opt.sync_every_call);
+        unsigned int call = 0;
+        perf_control("enable");
+        const Timing t = time_loop(comm, calls, [&] {
+          verlet->advance(steps / calls);
+          if (++call == calls)
+            verlet->sync_node_vectors();
+        });
+        perf_control("disable");
+        verlet->set_deferred_node_sync(false);
+        t_step.wall    = std::min(t_step.wall, t.wall);
+        t_step.cpu     = std::min(t_step.cpu, t.cpu);
+        loop_wall.push_back(t.total);
+        loop_cpu.push_back(t.total_cpu);
+      }
+    const auto [wall_min, wall_max] = std::minmax_element(loop_wall.begin(), loop_wall.end());
+    const auto [cpu_min, cpu_max]   = std::minmax_element(loop_cpu.begin(), loop_cpu.end());
     print("step_seconds", t_step.wall / steps);
     print("bond_updates_per_s_per_core", bond_updates / (t_step.wall * n_ranks));
     print("bond_updates_per_cpu_second", bond_updates / t_step.cpu);
-    print("loop_seconds", t_step.total);
-    print("loop_bond_updates_per_s_per_core", bond_updates / (t_step.total * n_ranks));
-    print("loop_cpu_seconds", t_step.total_cpu);
-    print("loop_bond_updates_per_cpu_second", bond_updates / t_step.total_cpu);
-    print("broken_bond_fraction", double(model.n_broken_bonds()) / bonds);
+    print("loop_seconds", median(loop_wall));
+    print("loop_bond_updates_per_s_per_core", bond_updates / (median(loop_wall) * n_ranks));
+    print("loop_bond_updates_per_s_per_core_min", bond_updates / (*wall_max * n_ranks));
+    print("loop_bond_updates_per_s_per_core_max", bond_updates / (*wall_min * n_ranks));
+    print("loop_cpu_seconds", median(loop_cpu));
+    print("loop_bond_updates_per_cpu_second", bond_updates / median(loop_cpu));
+    print("loop_bond_updates_per_cpu_second_min", bond_updates / *cpu_max);
+    print("loop_bond_updates_per_cpu_second_max", bond_updates / *cpu_min);
+    print("broken_bond_fraction", double(model->n_broken_bonds()) / bonds);
+    // FNV-1a of the bytes of u, v, a and the broken flags of rank 0 after
+    // the last repeat: equal for every code path that is bitwise the same
+    // (e.g. with and without --sync-every-call).
+    {
+      std::uint64_t hash = 1469598103934665603ull;
+      const auto    add  = [&](const void *data, const std::size_t n) {
+        for (std::size_t k = 0; k < n; ++k)
+          hash = (hash ^ static_cast<const unsigned char *>(data)[k]) * 1099511628211ull;
+      };
+      for (const auto *field : {&verlet->displacement, &verlet->velocity, &verlet->acceleration})
+        for (unsigned int d = 0; d < dim; ++d)
+          add((*field)[d].begin(), disc->n_owned() * sizeof(double));
+      add(model->broken().data(), model->broken().size());
+      if (rank == 0)
+        std::printf("%sfinal_state_hash: %016llx\n", prefix.c_str(),
+                    static_cast<unsigned long long>(hash));
+    }
     flush();
+    if (opt.loop_only)
+      return;
 
     // The box-layout steps against node-ordered ones (advance() per step:
     // the deformed positions copied into the sweep's box and the forces
     // written back every step), round robin, CPU time (shared machine).
-    if (verlet.uses_box_state())
+    if (verlet->uses_box_state())
       {
         const unsigned int  k = std::max(3u, steps / 5);
         std::vector<double> ratio;
@@ -313,9 +404,9 @@ namespace
           {
             const Timing node = time_loop(comm, 1, [&] {
               for (unsigned int s = 0; s < k; ++s)
-                verlet.advance();
+                verlet->advance();
             });
-            const Timing box = time_loop(comm, 1, [&] { verlet.advance(k); });
+            const Timing box = time_loop(comm, 1, [&] { verlet->advance(k); });
             ratio.push_back(node.cpu / box.cpu);
             best_node = std::min(best_node, node.cpu);
           }
@@ -334,10 +425,10 @@ namespace
     // machine is shared. All count the same bond updates (bonds = both
     // copies of every bond), so the ratios are speed-ups.
     typename BondBasedOperator<dim>::VectorField force, force_full, force_sweep; // half, full, sweep
-    model.initialize(force);
-    model.initialize(force_full);
-    model.initialize(force_sweep);
-    const bool sweep_available = model.lattice_sweep_available();
+    model->initialize(force);
+    model->initialize(force_full);
+    model->initialize(force_sweep);
+    const bool sweep_available = model->lattice_sweep_available();
     Timing     t_force, t_full, t_sweep; // half, full list, sweep
     t_force.wall = t_force.cpu = t_full.wall = t_full.cpu = t_sweep.wall = t_sweep.cpu = 1e300;
     std::vector<double> half_ratio, sweep_ratio; // per round: cpu(full) / cpu(loop)
@@ -349,12 +440,12 @@ namespace
             if (loop == 2 && !sweep_available)
               continue;
             if (loop == 2)
-              model.set_lattice_sweep(true);
+              model->set_lattice_sweep(true);
             else
-              model.set_half_list(loop == 1);
+              model->set_half_list(loop == 1);
             auto &out = loop == 2 ? force_sweep : loop == 1 ? force : force_full;
             const Timing t =
-              time_loop(comm, steps, [&] { model.compute_forces(verlet.displacement, out); });
+              time_loop(comm, steps, [&] { model->compute_forces(verlet->displacement, out); });
             Timing &best = loop == 2 ? t_sweep : loop == 1 ? t_force : t_full;
             best.wall    = std::min(best.wall, t.wall);
             best.cpu     = std::min(best.cpu, t.cpu);
@@ -364,12 +455,8 @@ namespace
         if (sweep_available)
           sweep_ratio.push_back(cpu[0] / cpu[2]);
       }
-    const auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v.empty() ? 0. : v[v.size() / 2];
-    };
-    model.set_half_list(dim == 3);
-    model.set_lattice_sweep(true); // the library default
+    model->set_half_list(dim == 3);
+    model->set_lattice_sweep(true); // the library default
     double diff = 0., diff_sweep = 0., fmax = 0.;
     for (unsigned int d = 0; d < dim; ++d)
       for (unsigned int i = 0; i < disc->n_owned(); ++i)
@@ -517,6 +604,12 @@ namespace
                              for (unsigned int c; in >> c;)
                                opt.chunks.push_back(c);
                            }
+                         else if (arg == "--repeats")
+                           opt.repeats = std::max(1, std::stoi(next()));
+                         else if (arg == "--loop-only")
+                           opt.loop_only = true;
+                         else if (arg == "--sync-every-call")
+                           opt.sync_every_call = true;
                          else if (arg == "--trace-steps")
                            opt.trace_steps = std::stoi(next());
                          else if (arg == "--agreement")

@@ -10,6 +10,10 @@
 #   PMB_CASES   PMB cases (default "2d_m3 2d_m12 2d_m24 3d_m3 3d_m12")
 #   PMB_3D_STEPS  Verlet steps of the 3d_m3 case, run by both PeriDEAL and
 #               LAMMPS (default 50)
+#   PMB_3D_ROUNDS  interleaved rounds of the 3D comparison, each one
+#               PeriDEAL process and one LAMMPS run (default 5)
+#   PMB_3D_REPEATS  fresh-state PeriDEAL runs per round, their median is the
+#               round's figure (default 3)
 #   LAMMPS      0 to skip the LAMMPS comparison (default 1: run it, installing
 #               the Debian packages lammps and lammps-examples when `lmp` is
 #               missing)
@@ -30,6 +34,8 @@ ranks="${RANKS:-1}"
 cases="${CASES-2d_m3 2d_m12 3d_m3 3d_m12}"
 pmb_cases="${PMB_CASES-2d_m3 2d_m12 2d_m24 3d_m3 3d_m12}"
 pmb_3d_steps="${PMB_3D_STEPS:-50}"
+pmb_3d_rounds="${PMB_3D_ROUNDS:-5}"
+pmb_3d_repeats="${PMB_3D_REPEATS:-3}"
 use_lammps="${LAMMPS:-1}"
 loop_seconds="${SECONDS_PER_LOOP:-1}"
 
@@ -105,7 +111,7 @@ pmb_log="$build/pmb-benchmark.log"
 : > "$pmb_log"
 for c in $pmb_cases; do
   steps=()
-  [ "$c" = 3d_m3 ] && steps=(--steps "$pmb_3d_steps")
+  [ "$c" = 3d_m3 ] && steps=(--steps "$pmb_3d_steps" --repeats "$pmb_3d_repeats")
   "${launch[@]}" "$pmb_exe" --case "$c" --seconds "$loop_seconds" "${steps[@]}" \
     | tee -a "$pmb_log" | tee -a "$results"
 done
@@ -161,6 +167,13 @@ EOF_LMP
   } > "$1"
 }
 
+# The 3D comparison in PMB_3D_ROUNDS interleaved rounds: per round one
+# PeriDEAL process (PMB_3D_REPEATS runs of PMB_3D_STEPS steps, each from the
+# initial state, median; --loop-only) and one LAMMPS run of the same steps.
+# A 50-step PeriDEAL run is ~0.5 s, short enough for one slow slice of a
+# shared machine to move it by 20 %, so the keys are the medians over the
+# rounds (ratio = median PeriDEAL rate / median LAMMPS rate), with the
+# spread of the per-round ratios as _min/_max keys.
 if [ "$lammps_ok" = 1 ] && grep -q '^pmb_3d_m3_steps:' "$pmb_log"; then
   work="$build/lammps"
   mkdir -p "$work"
@@ -177,36 +190,68 @@ velocity        right set $v0 0.0 0.0 sum no units box
 velocity        left set -$v0 0.0 0.0 sum no units box
 EOF_LMP
   echo "run             $pmb_3d_steps" >> "$work/in.pmb_3d_m3"
-  ( cd "$work" && /usr/bin/time -f "lammps_max_rss_kb: %M" -o time.txt \
-      lmp -in in.pmb_3d_m3 -log log.pmb_3d_m3 -screen none ) \
-    || { echo "run-all: LAMMPS failed, see $work/log.pmb_3d_m3" >&2; lammps_ok=0; }
+  rounds="$work/rounds.txt"
+  : > "$rounds"
+  for r in $(seq 1 "$pmb_3d_rounds"); do
+    "${launch[@]}" "$pmb_exe" --case 3d_m3 --steps "$pmb_3d_steps" --repeats "$pmb_3d_repeats" \
+      --loop-only > "$work/perideal_round.keys"
+    ( cd "$work" && /usr/bin/time -f "lammps_max_rss_kb: %M" -o time.txt \
+        lmp -in in.pmb_3d_m3 -log log.pmb_3d_m3 -screen none ) \
+      || { echo "run-all: LAMMPS failed, see $work/log.pmb_3d_m3" >&2; lammps_ok=0; break; }
+    log="$work/log.pmb_3d_m3"
+    loop=$(awk '/^Loop time of/ { print $4 }' "$log" | tail -1)
+    # "Performance: ... 98.5% CPU use with 1 MPI tasks": CPU seconds of the loop.
+    lcpu=$(awk -v loop="$loop" '/% CPU use/ { for (f = 1; f <= NF; ++f) if ($f ~ /%$/) { sub("%", "", $f); print loop * $f / 100 } }' \
+             "$log" | tail -1)
+    # Per round: PeriDEAL wall and CPU rate, LAMMPS loop and CPU seconds.
+    echo "$(value pmb_3d_m3_loop_bond_updates_per_s_per_core "$work/perideal_round.keys")" \
+         "$(value pmb_3d_m3_loop_bond_updates_per_cpu_second "$work/perideal_round.keys")" \
+         "$(value pmb_3d_m3_loop_seconds "$work/perideal_round.keys")" "$loop" "$lcpu" >> "$rounds"
+  done
 fi
-if [ "$lammps_ok" = 1 ] && [ -f "$build/lammps/log.pmb_3d_m3" ]; then
+if [ "$lammps_ok" = 1 ] && [ -s "$build/lammps/rounds.txt" ]; then
   work="$build/lammps"
-  loop=$(awk '/^Loop time of/ { print $4 }' "$work/log.pmb_3d_m3" | tail -1)
   lsteps=$(awk '/^Loop time of/ { print $9 }' "$work/log.pmb_3d_m3" | tail -1)
-  # "Performance: ... 98.5% CPU use with 1 MPI tasks": CPU seconds of the loop.
-  lcpu=$(awk -v loop="$loop" '/% CPU use/ { for (f = 1; f <= NF; ++f) if ($f ~ /%$/) { sub("%", "", $f); print loop * $f / 100 } }' \
-           "$work/log.pmb_3d_m3" | tail -1)
   lbonds=$(awk '/total # of bonds/ { print $NF }' "$work/log.pmb_3d_m3" | tail -1)
   lrss=$(sed -n 's/^lammps_max_rss_kb: //p' "$work/time.txt")
-  awk -v loop="$loop" -v lcpu="$lcpu" -v steps="$lsteps" -v lb="$lbonds" -v rss="$lrss" \
-      -v ploop="$(value pmb_3d_m3_loop_seconds "$pmb_log")" \
-      -v prate="$(value pmb_3d_m3_loop_bond_updates_per_s_per_core "$pmb_log")" \
-      -v pcpurate="$(value pmb_3d_m3_loop_bond_updates_per_cpu_second "$pmb_log")" 'BEGIN {
-    lrate = lb * steps / loop
-    lcpurate = lb * steps / lcpu
-    printf "lammps_pmb_3d_m3_steps: %d\n", steps
-    printf "lammps_pmb_3d_m3_bonds: %d\n", lb
-    printf "lammps_pmb_3d_m3_loop_seconds: %.6g\n", loop
-    printf "lammps_pmb_3d_m3_loop_cpu_seconds: %.6g\n", lcpu
-    printf "lammps_pmb_3d_m3_bond_updates_per_s_per_core: %.6g\n", lrate
-    printf "lammps_pmb_3d_m3_bond_updates_per_cpu_second: %.6g\n", lcpurate
-    printf "lammps_pmb_3d_m3_peak_rss_bytes_per_bond: %.6g\n", rss * 1024 / lb
-    printf "pmb_3d_m3_speedup_over_lammps: %.6g\n", prate / lrate
-    printf "pmb_3d_m3_cpu_time_speedup_over_lammps: %.6g\n", pcpurate / lcpurate
-    printf "pmb_3d_m3_step_time_ratio_lammps_over_perideal: %.6g\n", loop / ploop
-  }' | tee -a "$results"
+  awk -v steps="$lsteps" -v lb="$lbonds" -v rss="$lrss" '
+    function median(a, k,   i, j, t) {
+      for (i = 2; i <= k; ++i) for (j = i; j > 1 && a[j - 1] > a[j]; --j) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }
+      return k % 2 ? a[(k + 1) / 2] : 0.5 * (a[k / 2] + a[k / 2 + 1])
+    }
+    function mn(a, k,   i, m) { m = a[1]; for (i = 2; i <= k; ++i) if (a[i] < m) m = a[i]; return m }
+    function mx(a, k,   i, m) { m = a[1]; for (i = 2; i <= k; ++i) if (a[i] > m) m = a[i]; return m }
+    {
+      ++k
+      prate[k] = $1; pcpu[k] = $2; ploop[k] = $3
+      lrate[k] = lb * steps / $4; lcpu[k] = lb * steps / $5; lloop[k] = $4; lcpusec[k] = $5
+      ratio[k] = prate[k] / lrate[k]; cratio[k] = pcpu[k] / lcpu[k]
+    }
+    END {
+      pr = median(prate, k); pc = median(pcpu, k); lr = median(lrate, k); lc = median(lcpu, k)
+      printf "pmb_3d_m3_rounds: %d\n", k
+      printf "pmb_3d_m3_rounds_loop_bond_updates_per_s_per_core: %.6g\n", pr
+      printf "pmb_3d_m3_rounds_loop_bond_updates_per_s_per_core_min: %.6g\n", mn(prate, k)
+      printf "pmb_3d_m3_rounds_loop_bond_updates_per_s_per_core_max: %.6g\n", mx(prate, k)
+      printf "pmb_3d_m3_rounds_loop_bond_updates_per_cpu_second: %.6g\n", pc
+      printf "lammps_pmb_3d_m3_steps: %d\n", steps
+      printf "lammps_pmb_3d_m3_bonds: %d\n", lb
+      printf "lammps_pmb_3d_m3_loop_seconds: %.6g\n", median(lloop, k)
+      printf "lammps_pmb_3d_m3_loop_cpu_seconds: %.6g\n", median(lcpusec, k)
+      printf "lammps_pmb_3d_m3_bond_updates_per_s_per_core: %.6g\n", lr
+      printf "lammps_pmb_3d_m3_bond_updates_per_s_per_core_min: %.6g\n", mn(lrate, k)
+      printf "lammps_pmb_3d_m3_bond_updates_per_s_per_core_max: %.6g\n", mx(lrate, k)
+      printf "lammps_pmb_3d_m3_bond_updates_per_cpu_second: %.6g\n", lc
+      printf "lammps_pmb_3d_m3_peak_rss_bytes_per_bond: %.6g\n", rss * 1024 / lb
+      printf "pmb_3d_m3_speedup_over_lammps: %.6g\n", pr / lr
+      printf "pmb_3d_m3_speedup_over_lammps_round_median: %.6g\n", median(ratio, k)
+      printf "pmb_3d_m3_speedup_over_lammps_min: %.6g\n", mn(ratio, k)
+      printf "pmb_3d_m3_speedup_over_lammps_max: %.6g\n", mx(ratio, k)
+      printf "pmb_3d_m3_cpu_time_speedup_over_lammps: %.6g\n", pc / lc
+      printf "pmb_3d_m3_cpu_time_speedup_over_lammps_min: %.6g\n", mn(cratio, k)
+      printf "pmb_3d_m3_cpu_time_speedup_over_lammps_max: %.6g\n", mx(cratio, k)
+      printf "pmb_3d_m3_step_time_ratio_lammps_over_perideal: %.6g\n", median(lloop, k) / median(ploop, k)
+    }' "$work/rounds.txt" | tee -a "$results"
 fi
 
 # The agreement case: 12^3 nodes, m = 3, LAMMPS's bond family in PeriDEAL,

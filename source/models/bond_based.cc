@@ -261,42 +261,42 @@ namespace PeriDEAL
 
   template <int dim>
   std::uint64_t
-  BondBasedOperator<dim>::find_bond(const unsigned int i, const unsigned int target) const
-  {
-    // A row lists its bonds in increasing stencil-box index.
-    const auto   &nb = disc.neighborhood;
-    std::uint64_t lo = nb.row_start[i], hi = nb.row_start[i + 1];
-    while (lo < hi)
-      {
-        const std::uint64_t mid = (lo + hi) / 2;
-        if (box_index(i, mid) < target)
-          lo = mid + 1;
-        else
-          hi = mid;
-      }
-    AssertThrow(lo < nb.row_start[i + 1] && box_index(i, lo) == target,
-                ExcInternalError("A bond of the lattice sweep is missing in its row."));
-    return lo;
-  }
-
-  template <int dim>
-  std::uint64_t
   BondBasedOperator<dim>::find_sweep_bond(const unsigned int i,
                                           const unsigned int h,
-                                          const bool         upper) const
+                                          const bool         upper,
+                                          const std::int32_t partner) const
   {
     const auto        &nb = disc.neighborhood;
     const unsigned int S  = nb.stencil_size;
-    if (nb.table_start[i] == 0 && nb.row_start[i + 1] - nb.row_start[i] == S &&
-        sweep_slot[h] < S)
+    std::uint64_t      b  = nb.row_start[i];
+    const std::uint64_t end = nb.row_start[i + 1];
+    if (nb.table_start[i] == 0 && end - b == S && sweep_slot[h] < S)
+      b += upper ? S - 1 - sweep_slot[h] : sweep_slot[h];
+    else
       {
-        const std::uint64_t b = nb.row_start[i] + (upper ? S - 1 - sweep_slot[h] : sweep_slot[h]);
-        Assert(box_index(i, b) ==
-                 (upper ? 2 * centre_index() - sweep_box_index[h] : sweep_box_index[h]),
-               ExcInternalError());
-        return b;
+        // Another row: the bond's column is the partner (once per row). A
+        // scan of the contiguous columns, not a binary search over the box
+        // index, whose every probe loads a neighbour's lattice index (in the
+        // breaking steps that search was ~10 % of the step time).
+#ifdef PERIDEAL_PMB_AVX512
+        const __m512i key = _mm512_set1_epi32(partner);
+        for (; b + 16 <= end; b += 16)
+          if (const __mmask16 hit = _mm512_cmpeq_epi32_mask(
+                _mm512_loadu_si512(static_cast<const void *>(nb.col.data() + b)), key))
+            {
+              b += __builtin_ctz(hit);
+              break;
+            }
+#endif
+        while (b < end && nb.col[b] != partner)
+          ++b;
+        AssertThrow(b < end, ExcInternalError("A bond of the lattice sweep is missing in its row."));
       }
-    return find_bond(i, upper ? 2 * centre_index() - sweep_box_index[h] : sweep_box_index[h]);
+    Assert(nb.col[b] == partner &&
+             box_index(i, b) ==
+               (upper ? 2 * centre_index() - sweep_box_index[h] : sweep_box_index[h]),
+           ExcInternalError());
+    return b;
   }
 
   template <int dim>
@@ -1029,9 +1029,9 @@ namespace PeriDEAL
       {
         const std::int32_t lower = sweep_node[L], upper = sweep_node[L + sweep_offset[h]];
         if (lower < std::int32_t(n_owned))
-          broken_flag[find_sweep_bond(lower, h, false)] = 1;
+          broken_flag[find_sweep_bond(lower, h, false, upper)] = 1;
         if (upper < std::int32_t(n_owned))
-          broken_flag[find_sweep_bond(upper, h, true)] = 1;
+          broken_flag[find_sweep_bond(upper, h, true, lower)] = 1;
       }
 #else
     (void)p;

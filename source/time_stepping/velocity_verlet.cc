@@ -217,6 +217,8 @@ namespace PeriDEAL
     const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &v)
   {
     AssertThrow(mask.size() >= disc.n_owned(), ExcMessage("The mask must cover the owned nodes."));
+    // A node that becomes held starts from the node vectors' state.
+    sync_node_vectors();
     prescribed_values.push_back(v);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (mask[i])
@@ -233,6 +235,7 @@ namespace PeriDEAL
     const std::function<Tensor<1, dim>(const Point<dim> &, const double)> &u)
   {
     AssertThrow(mask.size() >= disc.n_owned(), ExcMessage("The mask must cover the owned nodes."));
+    sync_node_vectors();
     prescribed_displacements.push_back(u);
     displacement_nodes.clear();
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
@@ -295,8 +298,39 @@ namespace PeriDEAL
 
   template <int dim>
   void
+  VelocityVerlet<dim>::check_node_vectors_current() const
+  {
+    AssertThrow(!node_vectors_stale,
+                ExcMessage("VelocityVerlet: the node vectors are stale (deferred node sync); "
+                           "call sync_node_vectors() first."));
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::set_deferred_node_sync(const bool defer)
+  {
+    defer_node_sync = defer;
+    if (!defer)
+      sync_node_vectors();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::sync_node_vectors()
+  {
+    if (node_vectors_stale)
+      unload_box();
+    node_vectors_stale = false;
+    box_current        = false;
+  }
+
+  template <int dim>
+  void
   VelocityVerlet<dim>::initialize()
   {
+    // The caller has set the node vectors: they are the state.
+    node_vectors_stale = false;
+    box_current        = false;
     apply_prescribed_velocities(t);
     apply_prescribed_displacements(t, false);
     update_accelerations();
@@ -307,6 +341,8 @@ namespace PeriDEAL
   void
   VelocityVerlet<dim>::restart(const unsigned int step, const double time)
   {
+    node_vectors_stale = false;
+    box_current        = false;
     n_steps = step;
     t       = time;
     if (body_force_function)
@@ -319,6 +355,7 @@ namespace PeriDEAL
   void
   VelocityVerlet<dim>::advance()
   {
+    sync_node_vectors();
     const unsigned int n = disc.n_owned();
     // Held nodes: u^{n+1} from the prescribed function, v = du/dt by the
     // difference quotient (set first: it needs u^n); velocity sets drift
@@ -437,35 +474,59 @@ namespace PeriDEAL
     // same kick and drift. Positions without a local node stay zero in every
     // array, and box_b is zero unless there is a body force.
     // Raw pointers: through the vectors, every store would reload them.
+    // From a current box (deferred sync) the same kick and drift run in box
+    // order with a^n = (F + b) / rho as unload_box() forms it (b: the box's
+    // body force of the last step, read before it is reloaded below), and
+    // a^n = 0 at held nodes; ghost positions are refreshed in every step.
     const double h0 = 0.5 * dt, tau0 = dt;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        const double *__restrict un = displacement[d].begin();
-        const double *__restrict vn = velocity[d].begin();
-        const double *__restrict an = acceleration[d].begin();
-        const double *__restrict x  = box_x.data() + d * N;
-        const std::uint8_t *__restrict kind = box_kind.data();
-        double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
-        double *__restrict p = box_p.data() + d * N, *__restrict f = box_f.data() + d * N;
-        for (std::size_t i = 0; i < n_local; ++i)
-          {
-            const std::size_t L  = pos[i];
-            const bool        ow = i < n_owned;
-            double            ui = un[i];
-            double            vi = ow ? vn[i] : 0.;
-            const double      ai = ow ? an[i] : 0.;
-            if (!ow || kind[L] == 2)
+    if (box_current)
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double *__restrict x          = box_x.data() + d * N;
+          const double *__restrict b          = box_b.data() + d * N;
+          const std::uint8_t *__restrict kind = box_kind.data();
+          double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+          double *__restrict p = box_p.data() + d * N, *__restrict f = box_f.data() + d * N;
+          for (std::size_t L = 0; L < N; ++L)
+            if (kind[L] == 2)
               {
-                vi += h0 * ai;
-                ui += tau0 * vi;
-                p[L] = x[L] + ui;
+                const double a = inv_rho * (f[L] + b[L]);
+                v[L] += h0 * a;
+                u[L] += tau0 * v[L];
+                p[L] = x[L] + u[L];
               }
-            else
-              f[L] = ai;
-            u[L] = ui;
-            v[L] = vi;
-          }
-      }
+            else if (kind[L] == 1)
+              f[L] = 0.;
+        }
+    else
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double *__restrict un = displacement[d].begin();
+          const double *__restrict vn = velocity[d].begin();
+          const double *__restrict an = acceleration[d].begin();
+          const double *__restrict x  = box_x.data() + d * N;
+          const std::uint8_t *__restrict kind = box_kind.data();
+          double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
+          double *__restrict p = box_p.data() + d * N, *__restrict f = box_f.data() + d * N;
+          for (std::size_t i = 0; i < n_local; ++i)
+            {
+              const std::size_t L  = pos[i];
+              const bool        ow = i < n_owned;
+              double            ui = un[i];
+              double            vi = ow ? vn[i] : 0.;
+              const double      ai = ow ? an[i] : 0.;
+              if (!ow || kind[L] == 2)
+                {
+                  vi += h0 * ai;
+                  ui += tau0 * vi;
+                  p[L] = x[L] + ui;
+                }
+              else
+                f[L] = ai;
+              u[L] = ui;
+              v[L] = vi;
+            }
+        }
     if (has_body || box_b_nonzero)
       for (unsigned int d = 0; d < dim; ++d)
         for (unsigned int i = 0; i < n_owned; ++i)
@@ -574,7 +635,22 @@ namespace PeriDEAL
         ++n_steps;
       }
 
+    node_vectors_stale = defer_node_sync;
+    box_current        = defer_node_sync;
+    if (!defer_node_sync)
+      unload_box();
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::unload_box()
+  {
     // Back to the node vectors (a as update_accelerations() sets it).
+    const std::size_t                 N       = sweep_model->lattice_sweep_stride();
+    const std::vector<std::uint32_t> &pos     = sweep_model->lattice_sweep_positions();
+    const unsigned int                n_owned = disc.n_owned();
+    const std::size_t                 n_local = disc.position.size();
+    const double                      inv_rho = 1. / rho;
     for (unsigned int d = 0; d < dim; ++d)
       {
         const double *__restrict u = box_u.data() + d * N, *__restrict v = box_v.data() + d * N;
@@ -619,6 +695,7 @@ namespace PeriDEAL
   double
   VelocityVerlet<dim>::kinetic_energy() const
   {
+    check_node_vectors_current();
     double e = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
@@ -634,6 +711,7 @@ namespace PeriDEAL
   Tensor<1, dim>
   VelocityVerlet<dim>::linear_momentum() const
   {
+    check_node_vectors_current();
     Tensor<1, dim> p;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       for (unsigned int d = 0; d < dim; ++d)

@@ -741,7 +741,10 @@ namespace
   // touches: pre-cut and newly breaking bonds, a prescribed velocity v(x, t)
   // on one strip, a prescribed displacement u(x, t) on another (which also
   // gives nonzero reaction forces through internal_force()), and a
-  // time-dependent body force; on 1 and 2 ranks (ghost exchange).
+  // time-dependent body force; on 1 and 2 ranks (ghost exchange). A third
+  // integrator defers the node vectors (set_deferred_node_sync): its calls
+  // continue from the box state, and after sync_node_vectors() (explicit,
+  // or by advance()) it must equal the others bitwise as well.
   template <int dim>
   void
   box_state_dim()
@@ -750,15 +753,16 @@ namespace
     const auto   disc = make_box<dim>(MPI_COMM_WORLD, side, 0.1, 0.3015);
     BondBasedModelParameters p;
     p.critical_stretch = 0.01;
-    BondBasedOperator<dim> op_a(*disc, p), op_b(*disc, p);
+    BondBasedOperator<dim> op_a(*disc, p), op_b(*disc, p), op_c(*disc, p);
     const auto cuts = [](const Point<dim> &a, const Point<dim> &b) {
       return a[0] < 0.75 && b[0] < 0.75 && (a[1] - 0.55) * (b[1] - 0.55) < 0.;
     };
     op_a.break_bonds(cuts);
     op_b.break_bonds(cuts);
+    op_c.break_bonds(cuts);
     const double        rho = 1.;
     const double        dt  = 0.8 * op_a.critical_time_step(rho);
-    VelocityVerlet<dim> a(op_a, rho, dt), b(op_b, rho, dt);
+    VelocityVerlet<dim> a(op_a, rho, dt), b(op_b, rho, dt), c(op_c, rho, dt);
     const std::string   tag = std::to_string(dim) + "D, " +
                             std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) + " ranks: ";
     if (BondBasedOperator<dim>::lattice_sweep_compiled())
@@ -784,7 +788,7 @@ namespace
       for (unsigned int i = 0; i < disc->n_owned(); ++i)
         f[dim - 1].local_element(i) = 0.01 * std::sin(disc->position[i][0] + 10. * t);
     };
-    for (VelocityVerlet<dim> *v : {&a, &b})
+    for (VelocityVerlet<dim> *v : {&a, &b, &c})
       {
         for (unsigned int i = 0; i < disc->n_owned(); ++i)
           for (unsigned int d = 0; d < dim; ++d)
@@ -795,28 +799,64 @@ namespace
         v->initialize();
       }
     const std::uint64_t pre = op_a.n_broken_bonds();
-    unsigned int        differ = 0;
-    for (const unsigned int n : {3u, 1u, 7u, 13u, 16u})
+    const auto          count_differences = [&](const VelocityVerlet<dim>    &x,
+                                       const VelocityVerlet<dim>    &y,
+                                       const BondBasedOperator<dim> &op_x,
+                                       const BondBasedOperator<dim> &op_y) {
+      unsigned int n_differ = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          for (unsigned int i = 0; i < disc->n_owned() + disc->n_ghost(); ++i)
+            n_differ += x.displacement[d].local_element(i) != y.displacement[d].local_element(i);
+          for (unsigned int i = 0; i < disc->n_owned(); ++i)
+            n_differ += x.velocity[d].local_element(i) != y.velocity[d].local_element(i) ||
+                        x.acceleration[d].local_element(i) != y.acceleration[d].local_element(i) ||
+                        x.internal_force()[d].local_element(i) != y.internal_force()[d].local_element(i);
+        }
+      for (std::size_t k = 0; k < op_x.broken().size(); ++k)
+        n_differ += op_x.broken()[k] != op_y.broken()[k];
+      return n_differ + (x.step() != y.step() || x.time() != y.time());
+    };
+    c.set_deferred_node_sync(true);
+    unsigned int differ = 0, differ_deferred = 0, n_compared = 0;
+    bool         stale_detected = true;
+    for (const unsigned int n : {3u, 1u, 7u, 13u, 16u, 5u})
       {
         for (unsigned int s = 0; s < n; ++s)
           a.advance();
         b.advance(n);
-        for (unsigned int d = 0; d < dim; ++d)
+        differ += count_differences(a, b, op_a, op_b);
+        // c: 3 (stale), 1 (advance() syncs), 7, 13, 16 (three calls from
+        // the box), explicit sync, 5 (from the reloaded box), sync.
+        c.advance(n);
+        if (c.uses_box_state() && n != 1)
           {
-            for (unsigned int i = 0; i < disc->n_owned() + disc->n_ghost(); ++i)
-              differ += a.displacement[d].local_element(i) != b.displacement[d].local_element(i);
-            for (unsigned int i = 0; i < disc->n_owned(); ++i)
-              differ += a.velocity[d].local_element(i) != b.velocity[d].local_element(i) ||
-                        a.acceleration[d].local_element(i) != b.acceleration[d].local_element(i) ||
-                        a.internal_force()[d].local_element(i) != b.internal_force()[d].local_element(i);
+            bool threw = false;
+            try
+              {
+                (void)c.kinetic_energy();
+              }
+            catch (const std::exception &)
+              {
+                threw = true;
+              }
+            stale_detected = stale_detected && !c.node_vectors_current() && threw;
           }
-        for (std::size_t k = 0; k < op_a.broken().size(); ++k)
-          differ += op_a.broken()[k] != op_b.broken()[k];
-        differ += a.step() != b.step() || a.time() != b.time();
+        if (n == 1 || n == 16 || n == 5)
+          {
+            c.sync_node_vectors();
+            differ_deferred += count_differences(a, c, op_a, op_c);
+            ++n_compared;
+          }
       }
     differ = Utilities::MPI::sum(differ, MPI_COMM_WORLD);
     check(differ == 0, tag + std::to_string(differ) +
                          " values (u, v, a, F, broken flags, step, time) differ from advance()");
+    differ_deferred = Utilities::MPI::sum(differ_deferred, MPI_COMM_WORLD);
+    check(differ_deferred == 0 && n_compared == 3,
+          tag + std::to_string(differ_deferred) +
+            " values differ from advance() with deferred node sync");
+    check(stale_detected, tag + "stale node vectors are reported while the sync is deferred");
     const std::uint64_t broke = op_b.n_broken_bonds() - pre;
     check(pre > 0 && broke > 0, tag + std::to_string(pre) + " pre-cut, " + std::to_string(broke) +
                                   " newly broken bond copies");

@@ -474,15 +474,16 @@ namespace PeriDEAL
     /** The nonlinear force by the lattice sweep. */
     void
     sweep_forces(const VectorField &u, VectorField &force);
-    /** CSR index of the bond of owned row @p i with stencil-box index @p target. */
-    std::uint64_t
-    find_bond(const unsigned int i, const unsigned int target) const;
     /**
-     * find_bond() for the lower (@p upper false) or upper end @p i of a bond
-     * of positive sweep offset @p h: direct in a regular row.
+     * CSR index, in owned row @p i, of the bond of positive sweep offset @p h
+     * whose lower (@p upper false) or upper end is @p i and whose other end
+     * is the local node @p partner: direct in a regular row.
      */
     std::uint64_t
-    find_sweep_bond(const unsigned int i, const unsigned int h, const bool upper) const;
+    find_sweep_bond(const unsigned int i,
+                    const unsigned int h,
+                    const bool         upper,
+                    const std::int32_t partner) const;
     /** Build half_offset and the ghost list. */
     void
     setup_half_list();

@@ -171,6 +171,7 @@ namespace PeriDEAL
     const VectorField &
     internal_force() const
     {
+      check_node_vectors_current();
       return force;
     }
 
@@ -215,6 +216,39 @@ namespace PeriDEAL
       return sweep_model != nullptr && sweep_model->uses_lattice_sweep();
     }
 
+    /**
+     * Opt-in (default off): with @p defer true, advance(n) on the box state
+     * (uses_box_state(), n > 1) leaves the state in the box layout when it
+     * returns, and the next such call continues from it, without the
+     * conversions into and out of node order (one pass each over u, v, a
+     * and F per call). Until sync_node_vectors() the node vectors
+     * displacement, velocity, acceleration and internal_force() are stale:
+     * kinetic_energy(), linear_momentum(), strain_energy() and
+     * internal_force() throw, and a caller that reads or writes the public
+     * vectors directly must call sync_node_vectors() first. advance(),
+     * add_prescribed_velocity() and add_prescribed_displacement() sync
+     * themselves; initialize() and restart() take the node vectors as the
+     * state (they are called after setting them). The results are bitwise
+     * those of advance(n) without deferral. @p defer false syncs.
+     */
+    void
+    set_deferred_node_sync(const bool defer);
+
+    /**
+     * Write the box state back to the node vectors if they are stale (see
+     * set_deferred_node_sync()); the next advance(n) reloads the box from
+     * them, so the caller may then also modify them.
+     */
+    void
+    sync_node_vectors();
+
+    /** False between an advance(n) with deferred sync and sync_node_vectors(). */
+    bool
+    node_vectors_current() const
+    {
+      return !node_vectors_stale;
+    }
+
     /** The critical time step (3.8) of the model for this density. */
     double
     critical_time_step() const
@@ -245,6 +279,7 @@ namespace PeriDEAL
     double
     strain_energy() const
     {
+      check_node_vectors_current();
       return model.total_strain_energy(displacement);
     }
     /** sum_i rho V_i v_i over all ranks. */
@@ -293,6 +328,22 @@ namespace PeriDEAL
     std::vector<std::uint8_t> box_kind;
     /** box_b holds a body force (else it is zero). */
     bool box_b_nonzero = false;
+    /** set_deferred_node_sync(). */
+    bool defer_node_sync = false;
+    /**
+     * The box arrays hold the state (u, v, F, b, p) after the last step
+     * (a deferred advance(n)), and nothing has touched the node vectors
+     * since: the next advance(n) starts from the box.
+     */
+    bool box_current = false;
+    /** The node vectors lag behind the box state (deferred sync). */
+    bool node_vectors_stale = false;
+    /** Throw if node_vectors_stale. */
+    void
+    check_node_vectors_current() const;
+    /** Box state -> displacement, velocity, internal force, acceleration. */
+    void
+    unload_box();
     /**
      * Allocate the box arrays and box_x once (from initialize() and
      * restart(), so that the first advance(n) does not pay for it).
