@@ -467,6 +467,10 @@ namespace PeriDEAL
     bool                       sweep_live_valid = false;
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
+    /** x - x_c over the box (layout of sweep_p). */
+    std::vector<double> sweep_x0;
+    /** Runs (first local node, its box position, length) of consecutive nodes at consecutive positions. */
+    std::vector<std::array<std::uint32_t, 3>> fill_runs;
     /**
      * Per vector: lanes of shared-pattern WLS rows, of Omega_w rows; the
      * length classes to test (bit k).
