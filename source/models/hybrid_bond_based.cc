@@ -858,7 +858,9 @@ namespace PeriDEAL
     // every Omega_w lane of a vector with one to test. An exact test of a
     // node whose bound has not fired finds nothing critical at it (that is
     // what the bound proves), so the outcome is unchanged; its record only
-    // restarts its budget.
+    // restarts its budget. (With the lattice bound, test_lanes holds the
+    // lanes whose bound fired, and a vector whose fired lanes lie in one
+    // half tests only that half.)
     test_vectors.clear();
     for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
       if (test_lanes[v])

@@ -127,7 +127,8 @@ namespace PeriDEAL
    * offsets, eight consecutive positions at a time, with per-offset bits
    * for the unbroken bonds: the Omega_s rows (PMB force and breaking, the
    * arithmetic of BondBasedOperator's AVX-512 loops), the exact switching
-   * test (every Omega_w lane of a vector with a lane whose bound fired) and
+   * test (every Omega_w lane of a vector, or of a half of it, with a lane
+   * whose bound fired) and
    * the WLS rows of the interior collocation pattern, which share one set
    * of weights (those of the row of lowest id; rows whose own weights
    * differ, near boundaries, keep them). A row sums its bonds in a fixed
