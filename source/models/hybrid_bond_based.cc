@@ -446,6 +446,26 @@ namespace PeriDEAL
     sweep_p.assign(dim * sweep_n_alloc, 0.);
     sweep_u.assign(dim * sweep_n_alloc, 0.);
     sweep_live_valid = false;
+    // x - x_c over the box once (p = (x - x_c) + u per step, bitwise the
+    // value of the row loops), and the runs of consecutive nodes at
+    // consecutive box positions, so that the per-step copy of u into the box
+    // is a few contiguous (vectorized) loops instead of a scatter that
+    // re-reads the positions (2.4 of the 5.4 s of the switching test's
+    // timer at KW dx = 0.25 were that scatter).
+    {
+      const Point<dim> xc = op.deformation_origin();
+      sweep_x0.assign(dim * sweep_n_alloc, 0.);
+      const std::size_t N = sweep_n_alloc;
+      for (std::size_t i = 0; i < disc.position.size(); ++i)
+        for (unsigned int d = 0; d < dim; ++d)
+          sweep_x0[sweep_pad + d * N + sweep_position[i]] = disc.position[i][d] - xc[d];
+      fill_runs.clear();
+      for (std::uint32_t i = 0; i < disc.position.size(); ++i)
+        if (i > 0 && sweep_position[i] == sweep_position[i - 1] + 1)
+          ++fill_runs.back()[2];
+        else
+          fill_runs.push_back({{i, sweep_position[i], 1}});
+    }
     sweep_on         = true;
 
     all_offsets.resize(sweep_offset.size());
@@ -838,21 +858,24 @@ namespace PeriDEAL
     // every Omega_w lane of a vector with one to test. An exact test of a
     // node whose bound has not fired finds nothing critical at it (that is
     // what the bound proves), so the outcome is unchanged; its record only
-    // restarts its budget.
+    // restarts its budget. (With the lattice bound, test_lanes holds the
+    // lanes whose bound fired, and a vector whose fired lanes lie in one
+    // half tests only that half.)
     test_vectors.clear();
     for (std::uint32_t v = 0; v < sweep_n_vectors; ++v)
       if (test_lanes[v])
         test_vectors.push_back(v);
     const std::size_t   N  = sweep_n_alloc, n_f = sweep_offset.size();
     const double       *p  = sweep_p.data() + sweep_pad;
+    const std::int64_t *offset = sweep_offset.data();
+    const double       *iL2    = sweep_iL2.data();
     double             *crit = critical.begin();
     const std::int32_t *wf   = wls_mask.data();
     for (const std::uint32_t v : test_vectors)
       {
         const __mmask8    lanes   = wls_lanes[v];
-        const unsigned    classes = test_lanes[v];
+        const unsigned    classes = lip ? 1u : test_lanes[v];
         const std::size_t L0      = 8 * std::size_t(v);
-        exact_node_tests += __builtin_popcount(lanes);
         __m512d pi[dim];
         for (unsigned int d = 0; d < dim; ++d)
           pi[d] = _mm512_loadu_pd(p + d * N + L0);
@@ -863,30 +886,83 @@ namespace PeriDEAL
               continue;
             // The lattice bound covers all bonds of a node: one group.
             const std::vector<unsigned int> &group = lip ? all_offsets : class_offsets[k];
-            exact_bond_tests += std::uint64_t(__builtin_popcount(lanes)) * group.size();
+            // The lattice bound marks the lanes whose bound fired; if they
+            // all lie in one half of the vector, only the Omega_w lanes of
+            // that half are tested, with 256-bit vectors (half the work on
+            // a core that splits 512-bit operations; the lanes not tested
+            // keep their slack, which is still valid).
+            __mmask8     tl   = lanes;
+            const bool   half = dim == 2 && lip && ((test_lanes[v] & 0x0Fu) == 0 || (test_lanes[v] & 0xF0u) == 0);
+            const unsigned int h = half && (test_lanes[v] & 0x0Fu) == 0 ? 1 : 0;
+            if (half)
+              tl = __mmask8(((lanes >> (4 * h)) & 0x0Fu) << (4 * h));
+            exact_node_tests += __builtin_popcount(tl);
+            exact_bond_tests += std::uint64_t(__builtin_popcount(tl)) * group.size();
             // First q = max |y|^2 / T^2 only; the (rare) vectors with
             // q >= 1 - 1e-12 are scanned again for the bonds with
             // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
             // Four independent maxima (the chain of one is latency bound).
-            __m512d            qm[4] = {_mm512_setzero_pd(), _mm512_setzero_pd(),
-                                        _mm512_setzero_pd(), _mm512_setzero_pd()};
-            const unsigned int n_g   = group.size();
-            for (unsigned int g = 0; g < n_g; ++g)
+            // The four maxima in named registers, unrolled by hand, and the
+            // tables in locals: with qm[g % 4] GCC kept the maxima on the
+            // stack (a store and reload per bond) and reloaded the tables.
+            // The maximum is exact, so the grouping does not change q.
+            const unsigned int  n_g = group.size();
+            const unsigned int *grp = group.data();
+            __m512d             qmax;
+            if (half)
               {
-                const unsigned int f     = group[g];
-                const __mmask8     alive = bits[f] & lanes;
-                __m512d            y[dim];
-                const __m512d      l2 = lane_bonds<dim>(p, N, L0, sweep_offset[f], pi, y);
-                qm[g % 4] = _mm512_mask_max_pd(qm[g % 4], alive, qm[g % 4],
-                                               _mm512_mul_pd(l2, _mm512_set1_pd(sweep_iL2[f])));
+                const std::size_t L4 = L0 + 4 * h;
+                const __mmask8    l4 = tl >> (4 * h);
+                const __m256d     p0 = _mm256_loadu_pd(p + L4), p1 = _mm256_loadu_pd(p + N + L4);
+                const auto        q4_step = [&](__m256d &q, const unsigned int f) {
+                  const __mmask8 alive = (bits[f] >> (4 * h)) & l4;
+                  const __m256d  y0    = _mm256_sub_pd(_mm256_loadu_pd(p + L4 + offset[f]), p0);
+                  const __m256d  y1    = _mm256_sub_pd(_mm256_loadu_pd(p + N + L4 + offset[f]), p1);
+                  // |y|^2 by the expression of length2() (bitwise the 512-bit value).
+                  const __m256d l2 = _mm256_fmadd_pd(y1, y1, _mm256_mul_pd(y0, y0));
+                  q = _mm256_mask_max_pd(q, alive, q, _mm256_mul_pd(l2, _mm256_set1_pd(iL2[f])));
+                };
+                __m256d      r0 = _mm256_setzero_pd(), r1 = r0, r2 = r0, r3 = r0;
+                unsigned int g  = 0;
+                for (; g + 4 <= n_g; g += 4)
+                  {
+                    q4_step(r0, grp[g]);
+                    q4_step(r1, grp[g + 1]);
+                    q4_step(r2, grp[g + 2]);
+                    q4_step(r3, grp[g + 3]);
+                  }
+                for (; g < n_g; ++g)
+                  q4_step(r0, grp[g]);
+                const __m256d q4 = _mm256_max_pd(_mm256_max_pd(r0, r1), _mm256_max_pd(r2, r3));
+                qmax             = h ? _mm512_insertf64x4(_mm512_setzero_pd(), q4, 1) :
+                                       _mm512_zextpd256_pd512(q4);
               }
-            const __m512d qmax =
-              _mm512_max_pd(_mm512_max_pd(qm[0], qm[1]), _mm512_max_pd(qm[2], qm[3]));
+            else
+            {
+            const auto          q_step = [&](__m512d &q, const unsigned int f) {
+              const __mmask8 alive = bits[f] & lanes;
+              __m512d        y[dim];
+              const __m512d  l2 = lane_bonds<dim>(p, N, L0, offset[f], pi, y);
+              q = _mm512_mask_max_pd(q, alive, q, _mm512_mul_pd(l2, _mm512_set1_pd(iL2[f])));
+            };
+            __m512d      q0 = _mm512_setzero_pd(), q1 = q0, q2 = q0, q3 = q0;
+            unsigned int g  = 0;
+            for (; g + 4 <= n_g; g += 4)
+              {
+                q_step(q0, grp[g]);
+                q_step(q1, grp[g + 1]);
+                q_step(q2, grp[g + 2]);
+                q_step(q3, grp[g + 3]);
+              }
+            for (; g < n_g; ++g)
+              q_step(q0, grp[g]);
+            qmax = _mm512_max_pd(_mm512_max_pd(q0, q1), _mm512_max_pd(q2, q3));
+            }
             if (__builtin_expect(
                   _mm512_cmp_pd_mask(qmax, _mm512_set1_pd(1. - 1e-12), _CMP_GE_OQ) != 0, 0))
               for (const unsigned int f : group)
                 {
-                  const __mmask8 alive = bits[f] & lanes;
+                  const __mmask8 alive = bits[f] & tl;
                   if (alive == 0)
                     continue;
                   __m512d        y[dim];
@@ -917,7 +993,7 @@ namespace PeriDEAL
                 const __m512d slack = _mm512_sub_pd(
                   _mm512_fnmadd_pd(_mm512_set1_pd(kappa), _mm512_sqrt_pd(qmax), _mm512_set1_pd(kappa)),
                   _mm512_set1_pd(lip_margin));
-                _mm512_mask_storeu_pd(lip_remaining.data() + L0, lanes, slack);
+                _mm512_mask_storeu_pd(lip_remaining.data() + L0, tl, slack);
                 continue;
               }
             alignas(64) double q[8];
@@ -956,7 +1032,7 @@ namespace PeriDEAL
             // The first test: no increments yet, test every Omega_w vector.
             lip_have_prev = true;
             for (std::size_t v = 0; v < sweep_n_vectors; ++v)
-              test_lanes[v] = wls_lanes[v] != 0;
+              test_lanes[v] = wls_lanes[v];
             return;
           }
         const double *u = sweep_u.data() + sweep_pad, *w = lip_prev.data() + sweep_pad;
@@ -1007,8 +1083,7 @@ namespace PeriDEAL
           const __m512d r = _mm512_sub_pd(_mm512_loadu_pd(rem + L0), H);
           _mm512_storeu_pd(rem + L0, r);
           // Not > 0 (NaN too): test.
-          if (_mm512_mask_cmp_pd_mask(lanes, r, _mm512_setzero_pd(), _CMP_NGT_UQ) != 0)
-            test_lanes[v] = 1;
+          test_lanes[v] = _mm512_mask_cmp_pd_mask(lanes, r, _mm512_setzero_pd(), _CMP_NGT_UQ);
         };
         const std::size_t chunk = 512, lag3 = 8 * std::size_t((R + 15) / 8),
                           lag4 = 8 * std::size_t((std::max(R - 1, 0) * row + 15) / 8);
@@ -1114,30 +1189,65 @@ namespace PeriDEAL
     const std::size_t      N  = sweep_n_alloc;
     const double          *u  = sweep_u.data() + sweep_pad;
     const unsigned int     n_c = shared_offset.size();
-    for (const std::uint32_t v : shared_vectors)
+    // Two vectors at a time: each accumulator is a chain of 2 n_c
+    // dependent FMAs (latency bound with one vector: 10.9 ns per row at KW
+    // dx = 0.25); two vectors keep twice the chains in flight. Every lane
+    // sums the same terms in the same order as with one vector.
+    const double       *Wt  = shared_weight.data();
+    const std::int64_t *off = shared_offset.data();
+    const auto          store = [&](const std::size_t L0, const __mmask8 lanes, const __m512d *acc) {
+      alignas(64) double out[dim][8];
+      for (unsigned int d = 0; d < dim; ++d)
+        _mm512_store_pd(out[d], acc[d]);
+      for (unsigned int l = 0; l < 8; ++l)
+        if ((lanes >> l) & 1u)
+          for (unsigned int d = 0; d < dim; ++d)
+            force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+    };
+    const std::size_t n_v = shared_vectors.size();
+    std::size_t       k   = 0;
+    for (; k + 2 <= n_v; k += 2)
       {
-        const __mmask8    lanes = shared_lanes[v];
-        const std::size_t L0    = 8 * std::size_t(v);
+        const std::size_t L0 = 8 * std::size_t(shared_vectors[k]),
+                          L1 = 8 * std::size_t(shared_vectors[k + 1]);
+        __m512d           acc0[dim], acc1[dim];
+        for (unsigned int a = 0; a < dim; ++a)
+          acc0[a] = acc1[a] = _mm512_setzero_pd();
+        for (unsigned int c = 0; c < n_c; ++c)
+          {
+            const double *W = Wt + c2 * c;
+            for (unsigned int b = 0; b < dim; ++b)
+              {
+                const __m512d ub0 = _mm512_loadu_pd(u + b * N + L0 + off[c]);
+                const __m512d ub1 = _mm512_loadu_pd(u + b * N + L1 + off[c]);
+                for (unsigned int a = 0; a < dim; ++a)
+                  {
+                    const __m512d w = _mm512_set1_pd(W[a * dim + b]);
+                    acc0[a]         = _mm512_fmadd_pd(w, ub0, acc0[a]);
+                    acc1[a]         = _mm512_fmadd_pd(w, ub1, acc1[a]);
+                  }
+              }
+          }
+        store(L0, shared_lanes[shared_vectors[k]], acc0);
+        store(L1, shared_lanes[shared_vectors[k + 1]], acc1);
+      }
+    for (; k < n_v; ++k)
+      {
+        const std::size_t L0 = 8 * std::size_t(shared_vectors[k]);
         __m512d           acc[dim];
         for (unsigned int a = 0; a < dim; ++a)
           acc[a] = _mm512_setzero_pd();
         for (unsigned int c = 0; c < n_c; ++c)
           {
-            const double *W = shared_weight.data() + c2 * c;
+            const double *W = Wt + c2 * c;
             for (unsigned int b = 0; b < dim; ++b)
               {
-                const __m512d ub = _mm512_loadu_pd(u + b * N + L0 + shared_offset[c]);
+                const __m512d ub = _mm512_loadu_pd(u + b * N + L0 + off[c]);
                 for (unsigned int a = 0; a < dim; ++a)
                   acc[a] = _mm512_fmadd_pd(_mm512_set1_pd(W[a * dim + b]), ub, acc[a]);
               }
           }
-        alignas(64) double out[dim][8];
-        for (unsigned int d = 0; d < dim; ++d)
-          _mm512_store_pd(out[d], acc[d]);
-        for (unsigned int l = 0; l < 8; ++l)
-          if ((lanes >> l) & 1u)
-            for (unsigned int d = 0; d < dim; ++d)
-              force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+        store(L0, shared_lanes[shared_vectors[k]], acc);
       }
 #else
     (void)force;
@@ -1172,12 +1282,20 @@ namespace PeriDEAL
         for (unsigned int d = 0; d < dim; ++d)
           {
             const double *ud = u[d].begin();
+            const double *xd = sweep_x0.data() + sweep_pad + d * N;
             double       *pd = sweep_p.data() + sweep_pad + d * N;
             double       *vd = sweep_u.data() + sweep_pad + d * N;
-            for (std::size_t i = 0; i < n_local; ++i)
+            for (const auto &[i0, L0, n] : fill_runs)
               {
-                pd[sweep_position[i]] = (x[i][d] - xc[d]) + ud[i];
-                vd[sweep_position[i]] = ud[i];
+                const double *__restrict ui = ud + i0;
+                const double *__restrict xi = xd + L0;
+                double *__restrict pi       = pd + L0;
+                double *__restrict vi       = vd + L0;
+                for (std::uint32_t k = 0; k < n; ++k)
+                  {
+                    pi[k] = xi[k] + ui[k];
+                    vi[k] = ui[k];
+                  }
               }
           }
       }

@@ -127,7 +127,8 @@ namespace PeriDEAL
    * offsets, eight consecutive positions at a time, with per-offset bits
    * for the unbroken bonds: the Omega_s rows (PMB force and breaking, the
    * arithmetic of BondBasedOperator's AVX-512 loops), the exact switching
-   * test (every Omega_w lane of a vector with a lane whose bound fired) and
+   * test (every Omega_w lane of a vector, or of a half of it, with a lane
+   * whose bound fired) and
    * the WLS rows of the interior collocation pattern, which share one set
    * of weights (those of the row of lowest id; rows whose own weights
    * differ, near boundaries, keep them). A row sums its bonds in a fixed
@@ -467,6 +468,10 @@ namespace PeriDEAL
     bool                       sweep_live_valid = false;
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
+    /** x - x_c over the box (layout of sweep_p). */
+    std::vector<double> sweep_x0;
+    /** Runs (first local node, its box position, length) of consecutive nodes at consecutive positions. */
+    std::vector<std::array<std::uint32_t, 3>> fill_runs;
     /**
      * Per vector: lanes of shared-pattern WLS rows, of Omega_w rows; the
      * length classes to test (bit k).
