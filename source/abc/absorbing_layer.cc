@@ -135,6 +135,10 @@ namespace PeriDEAL
               // Mean of sigma along the bond (the stretched bond length).
               const double s_ij = std::abs(r_j - r_i) > 1e-9 * lattice.dx ? (Sigma(r_j) - Sigma(r_i)) / (r_j - r_i) :
                                                                           sigma(r_i);
+              // Outside the PML (sigma_i = 0) the node memory stays 0, so a
+              // bond with sigma_ij = 0 (memory 0 for ever) adds nothing.
+              if (sigma(r_i) == 0. && s_ij == 0.)
+                continue;
               col.push_back(j);
               weight.push_back((normals[c] * e) * (normals[c] * e) * k[q - nb.row_start[i]]);
               bond_decay.push_back(std::exp(-s_ij * dt));
