@@ -429,6 +429,8 @@ namespace PeriDEAL
           check_parameter(!keep, "Absorbing boundary/Method", "pml",
                           "ebf or sponge when part of the boundary is a physical surface (the PML "
                           "stretches the distance to the whole truncation boundary)");
+          check_parameter(op->is_linearized(), "Model/Linearized", "false",
+                          "true with method pml (the stretching acts on the linearized bond force)");
           pml_band.reinit(disc, domain, op->bond_coefficients(), prm.pml_damping, prm.pml_thickness,
                           prm.pml_exponent, dt, 2);
         }

@@ -629,6 +629,31 @@ namespace
     WaveAbcParameters first = abc_parameters();
     first.method            = "first order";
     check(fails_naming(first, "Method"), "Method = first order (elastic): ParameterError naming 'Method'");
+    // A physical free surface (keep filter) or the nonlinear model: refused.
+    const auto setup_fails_naming = [&](const bool with_keep, const std::string &name) {
+      LatticeParameters lp;
+      lp.dx    = 1.;
+      lp.delta = 3.;
+      ElasticWaveParameters wp;
+      wp.time_step                        = 0.5;
+      BondBasedModelParameters       model = linear_model();
+      FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+      model.linearized = with_keep;
+      PdUnboundedElastic pd(MPI_COMM_SELF);
+      try
+        {
+          pd.setup(BallDomain<2>(Point<2>(), 11.), lp, model, wp, ElasticTruncation::pml, prm, u0,
+                   with_keep ? [](const Point<2> &, const Tensor<1, 2> &n) { return n[1] < 0.5; } :
+                               std::function<bool(const Point<2> &, const Tensor<1, 2> &)>());
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(name) != std::string::npos;
+        }
+      return false;
+    };
+    check(setup_fails_naming(true, "Method"), "PML with a keep filter: ParameterError naming 'Method'");
+    check(setup_fails_naming(false, "Linearized"), "PML with the nonlinear model: ParameterError naming 'Linearized'");
   }
 
   // One-step spectral radius of the undamped PML near field (a disc small

@@ -175,7 +175,8 @@ namespace PeriDEAL
        * (weight (n . e)^2, e = xi/|xi|) has its elongation e . (u_j - u_i)
        * complex-stretched with one memory per bond and the summed force one
        * memory per node and component (PmlBand). Nothing is overwritten.
-       * Not with a @p keep filter (the whole truncation boundary absorbs).
+       * Not with a @p keep filter (the whole truncation boundary absorbs)
+       * and only for the linearized model.
        */
       pml
     };

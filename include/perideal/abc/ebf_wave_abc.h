@@ -110,7 +110,8 @@ namespace PeriDEAL
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone
        * points within min(d_inf, 2 dx) (same for v); chi is the long-wave
-       * speed of the dispersion relation.
+       * speed of the dispersion relation; "sponge" or "pml" (PD, below).
+       * PdUnboundedElastic takes ebf, sponge or pml.
        */
       std::string method = "ebf";
       /**
@@ -130,8 +131,9 @@ namespace PeriDEAL
       /** Exponent p of the sponge profile. */
       double sponge_exponent = 2.;
       /**
-       * PD, method "pml": largest damping rate sigma_max of the perfectly
-       * matched layer (doc/design.md, session 8): complex stretching of the
+       * PD (scalar and elastic waves), method "pml": largest damping rate
+       * sigma_max of the perfectly matched layer (PmlBand; doc/design.md,
+       * sessions 8-9): complex stretching of the
        * normal coordinate, x_n -> x_n + (i/omega) Sigma(x_n), applied to the
        * nonlocal operator bond by bond. The normal part of a bond (weight
        * g = (n . xi/|xi|)^2, n: outward normal) has its difference u_j - u_i
