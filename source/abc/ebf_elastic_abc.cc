@@ -357,9 +357,16 @@ namespace PeriDEAL
       check_parameter(wave.time_step > 0. && wave.time_step <= dt_crit, "Time stepping/Time step",
                       wave.time_step,
                       "0 < dt <= " + std::to_string(dt_crit) + " (critical step (3.8))");
-      dt         = wave.time_step;
-      t          = 0.;
-      truncation = trunc;
+      dt = wave.time_step;
+      t  = 0.;
+      // ElasticTruncation::absorbing follows the method parameter.
+      check_parameter(trunc != ElasticTruncation::absorbing || prm_in.method == "ebf" ||
+                        prm_in.method == "sponge" || prm_in.method == "pml",
+                      "Absorbing boundary/Method", prm_in.method, "ebf, sponge or pml (elastic waves)");
+      truncation = trunc != ElasticTruncation::absorbing ? trunc :
+                   prm_in.method == "sponge"            ? ElasticTruncation::sponge :
+                   prm_in.method == "pml"               ? ElasticTruncation::pml :
+                                                          ElasticTruncation::absorbing;
       held_nodes.clear();
       fixed_nodes.clear();
       for (auto *field : {&u, &v, &a, &f})
@@ -380,7 +387,7 @@ namespace PeriDEAL
         prm.cloud_radius = lattice.delta;
       std::vector<unsigned int> nodes;
       std::vector<Tensor<1, 2>> normals;
-      if (truncation != ElasticTruncation::free)
+      if (truncation != ElasticTruncation::free && truncation != ElasticTruncation::pml)
         {
           const double layer = prm.layer_thickness > 0 ? prm.layer_thickness : lattice.delta;
           std::vector<unsigned int> all_nodes;
@@ -396,7 +403,9 @@ namespace PeriDEAL
       // The sponge (as PdUnboundedWave: sigma_max min(1, (s_in - s)/w)^p at
       // depth s; inside an overwritten or fixed layer, s_in = layer + w).
       damping.assign(disc.n_owned(), d);
-      if (truncation != ElasticTruncation::free && prm.sponge_damping > 0.)
+      if ((truncation == ElasticTruncation::absorbing || truncation == ElasticTruncation::fixed ||
+           truncation == ElasticTruncation::sponge) &&
+          prm.sponge_damping > 0.)
         {
           const double s_in =
             prm.sponge_thickness +
@@ -411,8 +420,22 @@ namespace PeriDEAL
       else
         check_parameter(truncation != ElasticTruncation::sponge, "Absorbing boundary/Sponge damping",
                         prm.sponge_damping, "> 0 with the sponge truncation");
-      n_layer_nodes =
-        Utilities::MPI::sum<types::global_dof_index>(nodes.size(), disc.get_mpi_communicator());
+      // The PML (doc/design.md, session 9): the scalar PD wave PML's band
+      // with the bond stiffness c omega beta V/|xi| of the linearized force
+      // k e (e . (u_j - u_i)); its elongations are stretched.
+      pml_band.clear();
+      if (truncation == ElasticTruncation::pml)
+        {
+          check_parameter(!keep, "Absorbing boundary/Method", "pml",
+                          "ebf or sponge when part of the boundary is a physical surface (the PML "
+                          "stretches the distance to the whole truncation boundary)");
+          check_parameter(op->is_linearized(), "Model/Linearized", "false",
+                          "true with method pml (the stretching acts on the linearized bond force)");
+          pml_band.reinit(disc, domain, op->bond_coefficients(), prm.pml_damping, prm.pml_thickness,
+                          prm.pml_exponent, dt, 2);
+        }
+      n_layer_nodes = Utilities::MPI::sum<types::global_dof_index>(
+        truncation == ElasticTruncation::pml ? pml_band.n_pml_nodes : nodes.size(), disc.get_mpi_communicator());
       if (truncation == ElasticTruncation::absorbing)
         {
           std::vector<types::global_dof_index> ids(disc.id.begin(), disc.id.end());
@@ -446,6 +469,7 @@ namespace PeriDEAL
           v[q].update_ghost_values();
         }
       op->compute_forces(u, f);
+      pml_band.apply(false, {{u[0].begin(), u[1].begin()}}, {{f[0].begin(), f[1].begin()}});
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
         for (unsigned int q = 0; q < 2; ++q)
           a[q].local_element(i) = f[q].local_element(i) / rho - 2. * damping[i] * v[q].local_element(i);
@@ -530,6 +554,7 @@ namespace PeriDEAL
       for (unsigned int q = 0; q < 2; ++q)
         u[q].update_ghost_values();
       op->compute_forces(u, f);
+      pml_band.apply(true, {{u[0].begin(), u[1].begin()}}, {{f[0].begin(), f[1].begin()}});
       for (unsigned int q = 0; q < 2; ++q)
         {
           double       *vv = v[q].begin(), *aa = a[q].begin();
@@ -576,13 +601,16 @@ namespace PeriDEAL
       const unsigned int               n = disc.n_owned();
       const std::vector<unsigned int> &c = abc.cloud_points();
       const unsigned int               nc = truncation == ElasticTruncation::absorbing ? c.size() : 0;
-      const unsigned int               m  = 4 * n + 4 * nc;
+      // The PML memories (bond, then node) follow u, v and the cloud levels.
+      std::vector<double> &bm = pml_band.bond_memory, &nm = pml_band.node_memory;
+      const unsigned int   m_pml = 4 * n + 4 * nc, m = m_pml + bm.size() + nm.size();
       check_parameter(m <= max_size, "State size of the spectral radius check", m,
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
       // Entry of component q: u at q n + i, v at (2 + q) n + i, u_old at
       // 4 n + q nc + k, v_old at 4 n + (2 + q) nc + k.
       const VectorField                        u0 = u, v0 = v, a0 = a;
       const std::array<std::vector<double>, 2> uo0 = u_old, vo0 = v_old;
+      const std::vector<double>                bm0 = bm, nm0 = nm;
       const double                             t0 = t, abc0 = abc_seconds, step0 = step_seconds;
       LAPACKFullMatrix<double>                 map(m, m);
       for (unsigned int col = 0; col < m; ++col)
@@ -600,6 +628,10 @@ namespace PeriDEAL
                   v_old[q][c[k]] = (col == 4 * n + (2 + q) * nc + k) ? 1. : 0.;
                 }
             }
+          for (unsigned int k = 0; k < bm.size(); ++k)
+            bm[k] = (col == m_pml + k) ? 1. : 0.;
+          for (unsigned int k = 0; k < nm.size(); ++k)
+            nm[k] = (col == m_pml + bm.size() + k) ? 1. : 0.;
           compute_acceleration();
           advance();
           for (unsigned int q = 0; q < 2; ++q)
@@ -615,12 +647,18 @@ namespace PeriDEAL
                   map(4 * n + (2 + q) * nc + k, col) = v_old[q][c[k]];
                 }
             }
+          for (unsigned int k = 0; k < bm.size(); ++k)
+            map(m_pml + k, col) = bm[k];
+          for (unsigned int k = 0; k < nm.size(); ++k)
+            map(m_pml + bm.size() + k, col) = nm[k];
         }
       u     = u0;
       v     = v0;
       a     = a0;
       u_old = uo0;
       v_old = vo0;
+      bm    = bm0;
+      nm    = nm0;
       for (unsigned int q = 0; q < 2; ++q)
         {
           u[q].update_ghost_values();
@@ -661,6 +699,18 @@ namespace PeriDEAL
           }
       const MPI_Comm comm = disc.get_mpi_communicator();
       return {{Utilities::MPI::sum(e[0], comm), Utilities::MPI::sum(e[1], comm)}};
+    }
+
+    double
+    PdUnboundedElastic::verlet_energy() const
+    {
+      const auto all = [](const Point<2> &) { return true; };
+      const auto e   = energy(all);
+      double     c   = 0.;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        for (unsigned int q = 0; q < 2; ++q)
+          c += f[q].local_element(i) * f[q].local_element(i) / rho * disc.volume[i];
+      return e[0] + e[1] - dt * dt / 8. * Utilities::MPI::sum(c, disc.get_mpi_communicator());
     }
 
     std::vector<PdUnboundedElastic::NodeState>
@@ -730,6 +780,7 @@ namespace PeriDEAL
           h.kinetic.push_back(e[0]);
           h.strain.push_back(e[1]);
           h.total.push_back(E[0] + E[1]);
+          h.verlet.push_back(solver.verlet_energy());
         }
       h.final_state   = solver.gather(region);
       h.stats         = solver.absorbing_boundary().statistics();

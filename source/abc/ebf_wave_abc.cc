@@ -102,7 +102,7 @@ namespace PeriDEAL
       prm.declare_entry("Sponge exponent", "2", Patterns::Double(0.),
                         "PD: p of the profile sigma = sigma_max min(1, (s_in - s)/w)^p over the depth s.");
       prm.declare_entry("PML damping", "0", Patterns::Double(0.),
-                        "PD, method pml: largest damping rate sigma_max of the PML (> 0).");
+                        "PD scalar and elastic waves, method pml: largest damping rate sigma_max of the PML (> 0).");
       prm.declare_entry("PML thickness", "0", Patterns::Double(0.),
                         "PD, method pml: PML width w, the outermost part of the near field (>= 2 dx).");
       prm.declare_entry("PML exponent", "2", Patterns::Double(1.),
@@ -906,55 +906,11 @@ namespace PeriDEAL
         check_parameter(!sponge_only, "Absorbing boundary/Sponge damping", prm_in.sponge_damping,
                         "> 0 with method sponge");
 
-      // The PML (doc/design.md, session 8): every node within w + delta of
-      // the truncation boundary (its bonds may reach into the PML), its
-      // outward normal n (gradient of the signed distance) and the normal
-      // part of its bonds, weighted by (n . xi/|xi|)^2 >= 0 (the isotropic
-      // weights ((dim + 2) (n . e)^2 - 1)/2, which tend to d^2/dn^2 exactly,
-      // are partly negative and made the layer unstable, see design.md).
-      for (auto *x : {&pml_nodes, &pml_start, &pml_col})
-        x->clear();
-      for (auto *x : {&pml_weight, &pml_bond_decay, &pml_bond_memory, &pml_node_decay, &pml_node_memory})
-        x->clear();
+      // The PML (doc/design.md, session 8), shared with the elastic driver.
+      pml_band.clear();
       if (pml)
-        {
-          const double w = prm_in.pml_thickness, sigma_max = prm_in.pml_damping, p = prm_in.pml_exponent;
-          check_parameter(sigma_max > 0., "Absorbing boundary/PML damping", sigma_max, "> 0 with method pml");
-          check_parameter(w >= 2. * lattice.dx * (1. - 1e-12), "Absorbing boundary/PML thickness", w,
-                          ">= 2 dx = " + std::to_string(2. * lattice.dx) + " with method pml");
-          check_parameter(p >= 1., "Absorbing boundary/PML exponent", p, ">= 1");
-          // sigma and its integral Sigma over the distance rho = w - depth.
-          const auto rho_of  = [&](const Point<dim> &x) { return w + domain.signed_distance(x); };
-          const auto sigma   = [&](const double r) { return r > 0. ? sigma_max * std::pow(r / w, p) : 0.; };
-          const auto Sigma   = [&](const double r) { return r > 0. ? sigma_max * w * std::pow(r / w, p + 1.) / (p + 1.) : 0.; };
-          std::vector<Tensor<1, dim>> normals;
-          find_absorbing_layer(disc, domain, w + lattice.delta, lattice.delta, pml_nodes, normals);
-          pml_start.push_back(0);
-          for (unsigned int c = 0; c < pml_nodes.size(); ++c)
-            {
-              const unsigned int i   = pml_nodes[c];
-              const double       r_i = rho_of(disc.position[i]);
-              pml_node_decay.push_back(std::exp(-sigma(r_i) * dt));
-              const double *kw = bond_kernel_weight.data() + nb.table_start[i];
-              for (std::uint64_t q = nb.row_start[i]; q < nb.row_start[i + 1]; ++q)
-                {
-                  const unsigned int   j   = nb.col[q];
-                  const Tensor<1, dim> xi  = disc.position[j] - disc.position[i];
-                  const double         c2  = (normals[c] * xi) * (normals[c] * xi) / xi.norm_square();
-                  const double         r_j = rho_of(disc.position[j]);
-                  // Mean of sigma along the bond (the stretched bond length).
-                  const double s_ij = std::abs(r_j - r_i) > 1e-9 * lattice.dx ?
-                                        (Sigma(r_j) - Sigma(r_i)) / (r_j - r_i) : sigma(r_i);
-                  pml_col.push_back(j);
-                  pml_weight.push_back(c2 * kw[q - nb.row_start[i]]);
-                  pml_bond_decay.push_back(std::exp(-s_ij * dt));
-                }
-              pml_start.push_back(pml_col.size());
-            }
-          // The memories start at zero (no history before t = 0).
-          pml_bond_memory.assign(pml_col.size(), 0.);
-          pml_node_memory.assign(pml_nodes.size(), 0.);
-        }
+        pml_band.reinit(disc, domain, bond_kernel_weight, prm_in.pml_damping, prm_in.pml_thickness,
+                        prm_in.pml_exponent, dt, 1);
       if (prm_in.dispersion == "local")
         relation = std::make_unique<WaveDispersion<dim>>(
           WaveDispersion<dim>::local(model.wave_speed, d));
@@ -1049,7 +1005,7 @@ namespace PeriDEAL
       t += dt;
       u.update_ghost_values();
       apply_operator();
-      pml_correction(true);
+      pml_band.apply(true, {{u.begin()}}, {{Lu.begin()}});
       // Trapezoidal damping: v^{n+1/2} - v^{n-1/2} = dt L u^n - dt D (v^{n+1/2}
       // + v^{n-1/2}), so the half-step energy decays for any D >= 0.
       const double *lu = Lu.begin();
@@ -1080,14 +1036,14 @@ namespace PeriDEAL
       const unsigned int               n = disc.n_owned();
       const std::vector<unsigned int> &c = abc.cloud_points();
       const unsigned int               n_abc = absorbing ? 2 * c.size() : 0;
-      const unsigned int               n_bond = pml_col.size(), n_pml = pml_nodes.size();
+      const unsigned int               n_bond = pml_band.bond_memory.size(), n_pml = pml_band.node_memory.size();
       const unsigned int               m     = 2 * n + n_abc + n_bond + n_pml;
       check_parameter(m <= max_size, "State size of the spectral radius check", m,
                       "<= " + std::to_string(max_size) + " (dense eigenvalue problem)");
       // Save the solver state.
       const Vector              u0 = u, v0 = v, a0 = a;
       const std::vector<double> uo0 = u_old, vo0 = v_old, up0 = u_prev, vh0 = v_half;
-      const std::vector<double> bm0 = pml_bond_memory, nm0 = pml_node_memory;
+      const std::vector<double> bm0 = pml_band.bond_memory, nm0 = pml_band.node_memory;
       const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
       const auto                set_state = [&](const std::vector<double> &x) {
         for (unsigned int i = 0; i < n; ++i)
@@ -1101,14 +1057,14 @@ namespace PeriDEAL
               u_old[c[q]] = x[2 * n + q];
               v_old[c[q]] = x[2 * n + c.size() + q];
             }
-        std::copy(x.begin() + 2 * n + n_abc, x.begin() + 2 * n + n_abc + n_bond, pml_bond_memory.begin());
-        std::copy(x.begin() + 2 * n + n_abc + n_bond, x.end(), pml_node_memory.begin());
+        std::copy(x.begin() + 2 * n + n_abc, x.begin() + 2 * n + n_abc + n_bond, pml_band.bond_memory.begin());
+        std::copy(x.begin() + 2 * n + n_abc + n_bond, x.end(), pml_band.node_memory.begin());
         u.update_ghost_values();
         v.update_ghost_values();
         // The acceleration of a consistent state (only read at nodes whose
         // v is not overwritten by the absorbing update).
         apply_operator();
-        pml_correction(false);
+        pml_band.apply(false, {{u.begin()}}, {{Lu.begin()}});
         for (unsigned int i = 0; i < n; ++i)
           a.local_element(i) = Lu.local_element(i) - 2. * damping[i] * v.local_element(i);
       };
@@ -1132,8 +1088,8 @@ namespace PeriDEAL
                 column[2 * n + q]            = u_old[c[q]];
                 column[2 * n + c.size() + q] = v_old[c[q]];
               }
-          std::copy(pml_bond_memory.begin(), pml_bond_memory.end(), column + 2 * n + n_abc);
-          std::copy(pml_node_memory.begin(), pml_node_memory.end(), column + 2 * n + n_abc + n_bond);
+          std::copy(pml_band.bond_memory.begin(), pml_band.bond_memory.end(), column + 2 * n + n_abc);
+          std::copy(pml_band.node_memory.begin(), pml_band.node_memory.end(), column + 2 * n + n_abc + n_bond);
         }
       u     = u0;
       v     = v0;
@@ -1142,8 +1098,8 @@ namespace PeriDEAL
       v_old  = vo0;
       u_prev = up0;
       v_half = vh0;
-      pml_bond_memory = bm0;
-      pml_node_memory = nm0;
+      pml_band.bond_memory = bm0;
+      pml_band.node_memory = nm0;
       u.update_ghost_values();
       v.update_ghost_values();
       t            = t0;
@@ -1262,34 +1218,6 @@ namespace PeriDEAL
       double       *lu = Lu.begin();
       for (const auto &[i, j, w] : broken)
         lu[i] -= w * (uu[j] - uu[i]);
-    }
-
-    template <int dim>
-    void
-    PdUnboundedWave<dim>::pml_correction(const bool update)
-    {
-      // Frequency domain: the normal part sum_j g w (u_j - u_i) becomes
-      // (1/s_i) sum_j g w (u_j - u_i)/s_ij. With s = 1 + i sigma/omega,
-      // x/s = x - m where m' + sigma m = sigma x; m is advanced by the
-      // exponential rule m <- e^{-sigma dt} m + (1 - e^{-sigma dt}) x.
-      const double *uu = u.begin();
-      double       *lu = Lu.begin();
-      for (unsigned int c = 0; c < pml_nodes.size(); ++c)
-        {
-          const unsigned int i = pml_nodes[c];
-          double             f = 0., memory = 0.;
-          for (unsigned int q = pml_start[c]; q < pml_start[c + 1]; ++q)
-            {
-              const double du = uu[pml_col[q]] - uu[i];
-              if (update)
-                pml_bond_memory[q] = pml_bond_decay[q] * pml_bond_memory[q] + (1. - pml_bond_decay[q]) * du;
-              f += pml_weight[q] * (du - pml_bond_memory[q]);
-              memory += pml_weight[q] * pml_bond_memory[q];
-            }
-          if (update)
-            pml_node_memory[c] = pml_node_decay[c] * pml_node_memory[c] + (1. - pml_node_decay[c]) * f;
-          lu[i] -= memory + pml_node_memory[c];
-        }
     }
 
     template <int dim>

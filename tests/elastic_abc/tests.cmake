@@ -7,10 +7,20 @@ perideal_add_test(NAME elastic_abc.unbounded COMMAND $<TARGET_FILE:elastic_abc_t
   LABELS convergence)
 perideal_add_test(NAME elastic_abc.ranks.np2 NPROCS 2
   COMMAND $<TARGET_FILE:elastic_abc_tests> ranks LABELS mpi)
+# The elastic PML (doc/design.md, session 9): E16 CI accuracy, 10,000
+# undamped steps, parameter errors (seconds); 1e6 undamped steps (long).
+perideal_add_test(NAME elastic_abc.pml COMMAND $<TARGET_FILE:elastic_abc_tests> pml
+  LABELS "unit;convergence")
+perideal_add_test(NAME elastic_abc.pml_long COMMAND $<TARGET_FILE:elastic_abc_tests> pml_long
+  LABELS long TIMEOUT 3000)
+perideal_add_test(NAME elastic_abc.pml_spectral_radius COMMAND $<TARGET_FILE:elastic_abc_tests> pml_spectral_radius
+  LABELS long TIMEOUT 1200)
 perideal_add_test(NAME elastic_abc.unbounded_long COMMAND $<TARGET_FILE:elastic_abc_tests> unbounded_long
   LABELS long TIMEOUT 3000)
 # step-8 with a reduced near field (disc radius 12, half-space 40 x 20).
 perideal_add_test(NAME elastic_abc.tutorial.step-8 COMMAND $<TARGET_FILE:step-8> ${CMAKE_CURRENT_LIST_DIR}/step-8-ci.prm
+  LABELS tutorial)
+perideal_add_test(NAME elastic_abc.tutorial.step-8-pml COMMAND $<TARGET_FILE:step-8> ${CMAKE_CURRENT_LIST_DIR}/step-8-ci-pml.prm
   LABELS tutorial)
 # Dense one-step map (about 4,000 x 4,000): ~40 s, so long.
 perideal_add_test(NAME elastic_abc.spectral_radius COMMAND $<TARGET_FILE:elastic_abc_tests> spectral_radius

@@ -167,7 +167,18 @@ namespace PeriDEAL
        * damping d + sigma(x) >= 0 per node (energy-stable, doc/design.md
        * session 7). The @p keep filter of setup() exempts nodes as for the layer.
        */
-      sponge
+      sponge,
+      /**
+       * The perfectly matched layer of WaveAbcParameters ("PML damping",
+       * "PML thickness", "PML exponent"; doc/design.md, sessions 8-9): the
+       * outermost w of the near field, where the normal part of each bond
+       * (weight (n . e)^2, e = xi/|xi|) has its elongation e . (u_j - u_i)
+       * complex-stretched with one memory per bond and the summed force one
+       * memory per node and component (PmlBand). Nothing is overwritten.
+       * Not with a @p keep filter (the whole truncation boundary absorbs)
+       * and only for the linearized model.
+       */
+      pml
     };
 
     /** Density, time step and damping of an elastic wave run. */
@@ -183,7 +194,9 @@ namespace PeriDEAL
      * 2D bond-based PD (linearized, or the PMB with bond breaking) on a
      * truncated domain with velocity Verlet (3.5)-(3.6) and the EBF
      * absorbing boundary on the nodes within delta_L of the truncation
-     * boundary (Sect. 4.3.5, 4.3.6); optionally a prescribed-velocity region
+     * boundary (Sect. 4.3.5, 4.3.6), or a damping sponge or a PML
+     * (ElasticTruncation; ElasticTruncation::absorbing follows
+     * "Absorbing boundary/Method": ebf, sponge or pml); optionally a prescribed-velocity region
      * (impact) and pre-cracks. Any number of ranks.
      */
     class PdUnboundedElastic
@@ -224,7 +237,7 @@ namespace PeriDEAL
        * Spectral radius of the linear one-step map of the whole truncated
        * system (linearized model, serial, at most @p max_size state
        * entries, else ParameterError): the state (u, v of all nodes,
-       * u^{n-1}, v^{n-1} of the cloud points) is mapped column by column
+       * u^{n-1}, v^{n-1} of the cloud points, the PML memories) is mapped column by column
        * through advance() and the eigenvalues of the dense matrix are
        * computed by LAPACK; the solver state is restored. The number of
        * eigenvalues of modulus > 1 + 1e-8 goes to @p n_unstable if given.
@@ -237,6 +250,16 @@ namespace PeriDEAL
       /** Kinetic and strain energy (4.169) of the nodes with inside(x) (all ranks). */
       std::array<double, 2>
       energy(const std::function<bool(const Point<2> &)> &inside) const;
+      /**
+       * The energy velocity Verlet conserves exactly for the undamped
+       * linearized free near field (the modified energy of a linear system),
+       * kinetic + strain - dt^2/8 sum_i rho |f_i/rho|^2 V_i over all nodes,
+       * f the force of the last step (with the PML correction). The plain
+       * kinetic + strain energy at whole steps oscillates by O(dt^2) even
+       * then, so monotonicity checks at fine sampling use this one.
+       */
+      double
+      verlet_energy() const;
       /** (x, u, damage) of the nodes with inside(x), gathered on all ranks in id order. */
       struct NodeState
       {
@@ -278,7 +301,7 @@ namespace PeriDEAL
       {
         return *relation;
       }
-      /** Number of nodes of the truncation layer (absorbing or fixed), all ranks. */
+      /** Number of nodes of the truncation layer (absorbing, fixed or PML), all ranks. */
       types::global_dof_index n_layer_nodes = 0;
       /** Wall seconds in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
@@ -288,6 +311,8 @@ namespace PeriDEAL
       std::unique_ptr<BondBasedOperator<2>> op;
       std::unique_ptr<ElasticDispersion>    relation;
       EbfElasticAbc                         abc;
+      /** The PML band (ElasticTruncation::pml), else empty. */
+      PmlBand<2>                            pml_band;
       VectorField                           u, v, a, f;
       std::array<std::vector<double>, 2>    u_old, v_old;
       std::vector<double>                   u_abc, v_abc;
@@ -312,6 +337,8 @@ namespace PeriDEAL
       std::vector<double> kinetic, strain;
       /** Total energy of the whole near field. */
       std::vector<double> total;
+      /** PdUnboundedElastic::verlet_energy() of the whole near field. */
+      std::vector<double> verlet;
       /** Node states of the compared region at the final time (id order). */
       std::vector<PdUnboundedElastic::NodeState> final_state;
       WaveCloudStatistics                        stats;

@@ -9,6 +9,7 @@
 #include <deal.II/base/tensor.h>
 #include <deal.II/base/types.h>
 
+#include <perideal/abc/absorbing_layer.h>
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
 #include <perideal/discretization/domain.h>
@@ -109,7 +110,8 @@ namespace PeriDEAL
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone
        * points within min(d_inf, 2 dx) (same for v); chi is the long-wave
-       * speed of the dispersion relation.
+       * speed of the dispersion relation; "sponge" or "pml" (PD, below).
+       * PdUnboundedElastic takes ebf, sponge or pml.
        */
       std::string method = "ebf";
       /**
@@ -129,8 +131,9 @@ namespace PeriDEAL
       /** Exponent p of the sponge profile. */
       double sponge_exponent = 2.;
       /**
-       * PD, method "pml": largest damping rate sigma_max of the perfectly
-       * matched layer (doc/design.md, session 8): complex stretching of the
+       * PD (scalar and elastic waves), method "pml": largest damping rate
+       * sigma_max of the perfectly matched layer (PmlBand; doc/design.md,
+       * sessions 8-9): complex stretching of the
        * normal coordinate, x_n -> x_n + (i/omega) Sigma(x_n), applied to the
        * nonlocal operator bond by bond. The normal part of a bond (weight
        * g = (n . xi/|xi|)^2, n: outward normal) has its difference u_j - u_i
@@ -502,14 +505,6 @@ namespace PeriDEAL
       /** Lu = L u (u with current ghosts), minus the broken bonds. */
       void
       apply_operator();
-      /**
-       * PML: adds the stretching correction -sum_j g w m_ij - n_i to Lu of
-       * the PML band, first advancing the memories to the current u if
-       * @p update.
-       */
-      void
-      pml_correction(const bool update);
-
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       std::unique_ptr<WaveDispersion<dim>>    relation;
@@ -521,14 +516,8 @@ namespace PeriDEAL
       std::vector<double>                     damping, v_half, u_prev;
       /** Broken bonds: owned row i, local column j, kernel weight. */
       std::vector<std::tuple<unsigned int, unsigned int, double>> broken;
-      /**
-       * PML (method "pml"): the band nodes (depth < w + delta), their bonds
-       * (CSR: column, g k, exp(-sigma_ij dt), bond memory m_ij), the node
-       * factor exp(-sigma_i dt) and node memory n_i.
-       */
-      std::vector<unsigned int>               pml_nodes, pml_start, pml_col;
-      std::vector<double>                     pml_weight, pml_bond_decay, pml_bond_memory;
-      std::vector<double>                     pml_node_decay, pml_node_memory;
+      /** PML (method "pml"): the band, its weights and memories. */
+      PmlBand<dim>                            pml_band;
       double                                  dt = 0., t = 0., d = 0.;
       bool                                    absorbing = false;
     };
