@@ -222,9 +222,10 @@ namespace
     return prm;
   }
 
-  ElasticRunHistory
-  run_case(const Case &c, const double radius, const ElasticTruncation tr, const WaveAbcParameters &prm,
-           const MPI_Comm comm = MPI_COMM_WORLD)
+  /** Set up @p pd for case @p c on a disc of @p radius with truncation @p tr. */
+  void
+  setup_case(PdUnboundedElastic &pd, const Case &c, const double radius, const ElasticTruncation tr,
+             const WaveAbcParameters &prm)
   {
     LatticeParameters lp;
     lp.dx    = c.dx;
@@ -240,9 +241,15 @@ namespace
     FunctionFromFunctionObjects<2> u0(
       {[w](const Point<2> &x) { return x[0] / w * std::exp(-x.square() / (w * w)); },
        [w](const Point<2> &x) { return x[1] / w * std::exp(-x.square() / (w * w)); }});
-    BallDomain<2>      disc(Point<2>(), radius);
+    pd.setup(BallDomain<2>(Point<2>(), radius), lp, linear_model(), wp, tr, prm, u0);
+  }
+
+  ElasticRunHistory
+  run_case(const Case &c, const double radius, const ElasticTruncation tr, const WaveAbcParameters &prm,
+           const MPI_Comm comm = MPI_COMM_WORLD)
+  {
     PdUnboundedElastic pd(comm);
-    pd.setup(disc, lp, linear_model(), wp, tr, prm, u0);
+    setup_case(pd, c, radius, tr, prm);
     const double R = c.R, delta = c.delta;
     return run_elastic_waves(pd, c.T, c.n_samples,
                              [R, delta](const Point<2> &x) { return x.norm() < R - delta - 1e-9; });
@@ -793,22 +800,12 @@ namespace
                          pml_parameters(1., w, 2.)});
     const unsigned int rounds = std::getenv("PML_COST_ROUNDS") ? std::atoi(std::getenv("PML_COST_ROUNDS")) : 5;
     std::vector<std::vector<double>> setup(configs.size()), steps(configs.size());
-    LatticeParameters                lp;
-    lp.dx    = c.dx;
-    lp.delta = c.delta;
-    ElasticWaveParameters wp;
-    wp.time_step = c.dt;
-    wp.damping   = c.damping;
-    const double                   w0 = c.w;
-    FunctionFromFunctionObjects<2> u0(
-      {[w0](const Point<2> &x) { return x[0] / w0 * std::exp(-x.square() / (w0 * w0)); },
-       [w0](const Point<2> &x) { return x[1] / w0 * std::exp(-x.square() / (w0 * w0)); }});
     for (unsigned int r = 0; r < rounds; ++r)
       for (unsigned int k = 0; k < configs.size(); ++k)
         {
           PdUnboundedElastic pd(MPI_COMM_SELF);
           const std::clock_t t0 = std::clock();
-          pd.setup(BallDomain<2>(Point<2>(), configs[k].radius), lp, linear_model(), wp, configs[k].tr, configs[k].prm, u0);
+          setup_case(pd, c, configs[k].radius, configs[k].tr, configs[k].prm);
           const std::clock_t t1 = std::clock();
           for (unsigned int n = 0; n < 1000; ++n)
             pd.advance();

@@ -1098,6 +1098,18 @@ namespace
     mp.time_step  = 0.02;
   }
 
+  /** @p pd on the E14 near field, disc of radius @p R, the pulse exp(-ln 2 |x|^2) at t = 0. */
+  void
+  setup_e14_disc(PdUnboundedWave<2> &pd, const double R, const WaveTruncation boundary, const WaveAbcParameters &prm)
+  {
+    LatticeParameters    lp;
+    ScalarWaveParameters mp;
+    e14_parameters(lp, mp);
+    const ScalarFunctionFromFunctionObject<2> u0(
+      [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
+    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, boundary, prm, u0);
+  }
+
   /**
    * Largest increase of the half-step energy E^{n+1/2} (scaled by its first
    * value) over @p n_steps steps of the E14 pulse on a disc of radius @p R;
@@ -1109,13 +1121,8 @@ namespace
                             const unsigned long n_steps, double &e_first, double &e_last, double &relative)
   {
     relative = 0.;
-    LatticeParameters    lp;
-    ScalarWaveParameters mp;
-    e14_parameters(lp, mp);
-    const ScalarFunctionFromFunctionObject<2> u0(
-      [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
     PdUnboundedWave<2> pd(MPI_COMM_SELF);
-    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, boundary, prm, u0);
+    setup_e14_disc(pd, R, boundary, prm);
     pd.advance();
     e_first       = pd.half_step_energy();
     double e_prev = e_first, increase = -1.;
@@ -1224,13 +1231,8 @@ namespace
   std::vector<double>
   pml_energy_history(const double w, const unsigned long n_steps, const unsigned int n_samples)
   {
-    LatticeParameters    lp;
-    ScalarWaveParameters mp;
-    e14_parameters(lp, mp);
-    const ScalarFunctionFromFunctionObject<2> u0(
-      [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
     PdUnboundedWave<2> pd(MPI_COMM_SELF);
-    pd.setup(BallDomain<2>(Point<2>(), 2.5 + w), lp, mp, WaveTruncation::absorbing, pml_parameters(2., w, 2.), u0);
+    setup_e14_disc(pd, 2.5 + w, WaveTruncation::absorbing, pml_parameters(2., w, 2.));
     const auto          all = [](const Point<2> &) { return true; };
     std::vector<double> e{pd.energy(all)};
     for (unsigned int s = 1; s <= n_samples; ++s)
