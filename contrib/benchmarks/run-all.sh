@@ -8,6 +8,10 @@
 #   RANKS       MPI ranks per benchmark (default 1)
 #   CASES       diffusion cases (default "2d_m3 2d_m12 3d_m3 3d_m12")
 #   PMB_CASES   PMB cases (default "2d_m3 2d_m12 2d_m24 3d_m3 3d_m12")
+#   PMB_2D_STEPS  timed Verlet steps (1..S, from the initial state) of the
+#               2d_m12 and 2d_m24 cases (default 30: 5-10 s per repeat)
+#   PMB_2D_REPEATS  fresh-state runs of them, the keys are their median
+#               (default 3)
 #   PMB_3D_STEPS  Verlet steps of the 3d_m3 case, run by both PeriDEAL and
 #               LAMMPS (default 50)
 #   PMB_3D_ROUNDS  interleaved rounds of the 3D comparison, each one
@@ -33,6 +37,8 @@ jobs="${JOBS:-$(nproc)}"
 ranks="${RANKS:-1}"
 cases="${CASES-2d_m3 2d_m12 3d_m3 3d_m12}"
 pmb_cases="${PMB_CASES-2d_m3 2d_m12 2d_m24 3d_m3 3d_m12}"
+pmb_2d_steps="${PMB_2D_STEPS:-30}"
+pmb_2d_repeats="${PMB_2D_REPEATS:-3}"
 pmb_3d_steps="${PMB_3D_STEPS:-50}"
 pmb_3d_rounds="${PMB_3D_ROUNDS:-5}"
 pmb_3d_repeats="${PMB_3D_REPEATS:-3}"
@@ -106,12 +112,16 @@ awk -F': ' '
 
 # ---------------------------------------------------------------------
 # PMB with fracture (pmb_benchmark); 3d_m3 runs a fixed number of steps,
-# the same as LAMMPS below.
+# the same as LAMMPS below; 2d_m12 and 2d_m24 a fixed window of
+# PMB_2D_STEPS steps, PMB_2D_REPEATS times from the initial state (their
+# keys are medians: a window of a few calibrated steps carried the VM's
+# speed phase directly).
 pmb_log="$build/pmb-benchmark.log"
 : > "$pmb_log"
 for c in $pmb_cases; do
   steps=()
   [ "$c" = 3d_m3 ] && steps=(--steps "$pmb_3d_steps" --repeats "$pmb_3d_repeats")
+  case "$c" in 2d_m12 | 2d_m24) steps=(--steps "$pmb_2d_steps" --repeats "$pmb_2d_repeats") ;; esac
   "${launch[@]}" "$pmb_exe" --case "$c" --seconds "$loop_seconds" "${steps[@]}" \
     | tee -a "$pmb_log" | tee -a "$results"
 done

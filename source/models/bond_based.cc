@@ -456,7 +456,13 @@ namespace PeriDEAL
     sweep_n_bytes = (sweep_n_box + 7) / 8;
     // Padding: the neighbour streams read up to the largest offset plus one
     // vector past the last box position.
+    // The component stride is a multiple of 8 (64-byte aligned components)
+    // with 8 N = 1344 mod 4096: the dim arrays of positions (page offset 0)
+    // and reactions (2048) then start at page offsets at least 640 bytes
+    // apart (0, 1344, 2688 and 2048, 3392, 640), so that the reaction store
+    // of one component is not 4K-aliased with the next component's loads.
     sweep_n_alloc = 8 * sweep_n_bytes + sweep_offset.back() + 16;
+    sweep_n_alloc = (sweep_n_alloc + 511 - 168) / 512 * 512 + 168;
     internal::LatticeSweep::map_box_positions<dim>(
       disc.lattice_index, sweep_lower, sweep_stride, sweep_n_box, sweep_position, sweep_node);
     sweep_p.assign(dim * sweep_n_alloc, 0.);

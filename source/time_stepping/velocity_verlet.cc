@@ -681,7 +681,7 @@ namespace PeriDEAL
     const std::size_t             N  = op.lattice_sweep_stride();
     if (box_u.size() == dim * N)
       return;
-    for (std::vector<double> *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
+    for (PageOffsetVector *b : {&box_u, &box_v, &box_f, &box_b, &box_p, &box_x})
       b->assign(dim * N, 0.);
     box_b_nonzero                     = false;
     const std::vector<std::uint32_t> &pos = op.lattice_sweep_positions();

@@ -5,6 +5,7 @@
 #include <deal.II/base/point.h>
 
 #include <perideal/base/kernel.h>
+#include <perideal/base/page_offset_allocator.h>
 #include <perideal/discretization/discretization.h>
 
 #include <array>
@@ -461,8 +462,15 @@ namespace PeriDEAL
     /** Bit slots of the offsets for the current offsets per pass (invalidates the bits). */
     void
     set_sweep_bit_slots();
-    /** Deformed positions and reactions per box position, dim arrays of sweep_n_alloc. */
-    std::vector<double> sweep_p, sweep_reaction;
+    /**
+     * Deformed positions and reactions per box position, dim arrays of
+     * sweep_n_alloc. The reactions start half a page after the positions
+     * (and after VelocityVerlet's box positions): the sweep stores
+     * reactions at L + o and loads positions at L + o' (see
+     * PageOffsetAllocator).
+     */
+    PageOffsetVector sweep_p{PageOffsetAllocator<double>(0)},
+      sweep_reaction{PageOffsetAllocator<double>(2048)};
     /** Scratch: (offset, box position) of the bonds broken in this call. */
     std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
     /** Set up the box, the offsets and sweep_available. */

@@ -201,11 +201,15 @@ namespace PeriDEAL
         // registers, and their spills cost 6-7 % (doc/benchmarks.md,
         // session 7). The empty asm keeps GCC from hoisting base + offset
         // out of the loop again. Per offset: k, k r and (r + s0 r)^2.
+        // The per-offset constants are read from memory as embedded
+        // broadcasts (8-byte loads) through a base pointer that the loop
+        // cannot hoist: as 3 NO zmm values GCC spilled them, and reloaded
+        // each as a 64-byte vector per bond vector (4 of the ~16 loads).
         const std::size_t   gs = bits.group_stride;
         std::uint8_t *const B  = bits.live + c0 / 8 * gs;
         std::size_t         bq[NO];
         std::int64_t        oq[NO];
-        __m512d             vk[NO], vkr[NO], vt2[NO];
+        double              cst[NO][3]; // k, k r, (r + s0 r)^2
         const double       *P[dim];
         double             *Rb[dim], *A[dim];
         for (unsigned int d = 0; d < dim; ++d)
@@ -218,11 +222,8 @@ namespace PeriDEAL
           {
             bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
             oq[q]            = o[hs[q]];
-            const __m512d vr = _mm512_set1_pd(r[hs[q]]);
-            const __m512d t  = _mm512_add_pd(vr, _mm512_mul_pd(_mm512_set1_pd(s0), vr));
-            vk[q]            = _mm512_set1_pd(k[hs[q]]);
-            vkr[q]           = _mm512_mul_pd(vk[q], vr);
-            vt2[q]           = _mm512_mul_pd(t, t);
+            pmb_offset_constants(r[hs[q]], k[hs[q]], s0, cst[q][1], cst[q][2]);
+            cst[q][0] = k[hs[q]];
           }
         const auto group = [&](const std::size_t v) {
           __mmask8      alive[NO], any = 0;
@@ -232,6 +233,8 @@ namespace PeriDEAL
             any |= alive[q] = Bv[bq[q]];
           if (any == 0)
             return;
+          const double(*c)[3] = cst;
+          asm("" : "+r"(c));
           __m512d pi[dim], f[dim];
           for (unsigned int d = 0; d < dim; ++d)
             {
@@ -254,7 +257,14 @@ namespace PeriDEAL
               for (unsigned int d = 1; d < dim; ++d)
                 l2 = _mm512_fmadd_pd(y[d], y[d], l2);
               __mmask8      brk;
-              const __m512d scale = pmb_bond_scale_kr(l2, alive[q], vk[q], vkr[q], vt2[q], brk);
+              // Dead lanes need no blend: they may compute inf or NaN, but
+              // return 0 (the default floating-point environment).
+              const __m512d scale = pmb_bond_scale_kr<false>(l2,
+                                                             alive[q],
+                                                             _mm512_set1_pd(c[q][0]),
+                                                             _mm512_set1_pd(c[q][1]),
+                                                             _mm512_set1_pd(c[q][2]),
+                                                             brk);
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   double *rd = Rb[d] + j;

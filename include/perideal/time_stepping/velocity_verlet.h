@@ -324,7 +324,13 @@ namespace PeriDEAL
      * force, body force, deformed position and reference position x - x_c;
      * per position 2 (free owned node), 1 (held owned node) or 0.
      */
-    std::vector<double>       box_u, box_v, box_f, box_b, box_p, box_x;
+    // Each at its own page offset (PageOffsetAllocator): the kicks stream
+    // over all six in step, the sweep reads box_p next to its reactions
+    // (page offset 2048).
+    PageOffsetVector box_u{PageOffsetAllocator<double>(512)},
+      box_v{PageOffsetAllocator<double>(1024)}, box_f{PageOffsetAllocator<double>(1536)},
+      box_b{PageOffsetAllocator<double>(2560)}, box_p{PageOffsetAllocator<double>(0)},
+      box_x{PageOffsetAllocator<double>(3072)};
     std::vector<std::uint8_t> box_kind;
     /** box_b holds a body force (else it is zero). */
     bool box_b_nonzero = false;
