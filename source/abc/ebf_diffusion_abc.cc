@@ -396,6 +396,9 @@ namespace PeriDEAL
       // The normal derivative adds the constant mode (derivative 0) so that
       // a constant field gives no flux.
       const bool         flux    = prm.imposed == "normal derivative";
+      check_parameter(prm.imposed == "value" || (flux && prm.fit != "bounded"), "Absorbing boundary/Imposed",
+                      prm.imposed + " with the " + prm.fit + " fit",
+                      "value, or normal derivative with the least squares, monotone or stabilized fit");
       const unsigned int n_modes = dirs.size() * k.size() + (flux ? 1 : 0);
       Eigen::RowVectorXd psi_dt(n_modes);
       Tensor<1, dim>     e; // R n: the outward normal in the local frame
