@@ -128,6 +128,27 @@ namespace PeriDEAL
           V -= x.segment(n, n).transpose();
         return V / V.sum();
       }
+
+      /**
+       * The monotone normal derivative at cloud point 0 (the absorbing
+       * point): dC/dn = sum_{j != 0} P_j (C_j - C_0) - q C_0 with P_j, q >= 0
+       * fitted to @p psi (the modes' normal derivatives) by nonnegative least
+       * squares. The boundary DoF's row keeps its sign structure: nonnegative
+       * couplings and a sink (a Robin-type condition), so that the value can
+       * fall below every value of its cloud, which no convex combination can.
+       */
+      Eigen::RowVectorXd
+      monotone_flux_fit(const Eigen::MatrixXd &M, const Eigen::RowVectorXd &psi)
+      {
+        Eigen::MatrixXd A(M.cols(), M.rows());
+        for (Eigen::Index j = 1; j < M.rows(); ++j)
+          A.col(j) = (M.row(j) - M.row(0)).transpose();
+        A.col(0)                = -M.row(0).transpose();
+        const Eigen::VectorXd x = nonnegative_least_squares(A, psi.transpose());
+        Eigen::RowVectorXd    V = x.transpose();
+        V[0]                    = -x.sum();
+        return V;
+      }
     } // namespace
 
 
@@ -162,6 +183,10 @@ namespace PeriDEAL
                         "bounded fit: V_j >= -this (negative: no bound).");
       prm.declare_entry("Maximum stabilization rounds", "60", Patterns::Integer(1, 1000),
                         "stabilized fit: rounds of power iteration and blending.");
+      prm.declare_entry("Imposed", "value", Patterns::Selection("value|normal derivative"),
+                        "value: the absorbing value at t^{n+1} as a Dirichlet value (4.31); normal "
+                        "derivative (FEM, explicit lumped): the fitted outward derivative at t^n as a "
+                        "Neumann flux.");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
@@ -187,11 +212,14 @@ namespace PeriDEAL
       l1_excess             = prm.get_double("Updating vector l1 excess");
       lower_bound           = prm.get_double("Updating vector lower bound");
       max_stabilization_rounds = prm.get_integer("Maximum stabilization rounds");
+      imposed                  = prm.get("Imposed");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
       check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
                         fit == "stabilized",
                       "Absorbing boundary/Updating vector fit", fit,
                       "least squares, monotone, bounded or stabilized");
+      check_parameter(imposed == "value" || fit != "bounded", "Absorbing boundary/Updating vector fit", fit,
+                      "least squares, monotone or stabilized with Imposed = normal derivative");
       check_parameter(l1_excess >= 0., "Absorbing boundary/Updating vector l1 excess", l1_excess, ">= 0");
     }
 
@@ -365,11 +393,22 @@ namespace PeriDEAL
           k[m]      = -dk * (m + 1.) / prm.n_wave_numbers;
           growth[m] = std::exp(dispersion(std::abs(k[m])) * dt);
         }
-      const unsigned int n_modes = dirs.size() * k.size();
+      // The normal derivative adds the constant mode (derivative 0) so that
+      // a constant field gives no flux.
+      const bool         flux    = prm.imposed == "normal derivative";
+      check_parameter(prm.imposed == "value" || (flux && prm.fit != "bounded"), "Absorbing boundary/Imposed",
+                      prm.imposed + " with the " + prm.fit + " fit",
+                      "value, or normal derivative with the least squares, monotone or stabilized fit");
+      const unsigned int n_modes = dirs.size() * k.size() + (flux ? 1 : 0);
       Eigen::RowVectorXd psi_dt(n_modes);
+      Tensor<1, dim>     e; // R n: the outward normal in the local frame
+      for (unsigned int d = 0; d < dim; ++d)
+        e[d] = 1. / std::sqrt(double(dim));
       for (unsigned int l = 0; l < dirs.size(); ++l)
         for (unsigned int m = 0; m < k.size(); ++m)
-          psi_dt[l * k.size() + m] = growth[m];
+          psi_dt[l * k.size() + m] = flux ? k[m] * (dirs[l] * e) : growth[m];
+      if (flux)
+        psi_dt[n_modes - 1] = 0.;
 
       // Bin the points on a grid of width d_inf for the cloud search.
       const double                               r = prm.cloud_radius;
@@ -429,6 +468,8 @@ namespace PeriDEAL
                   for (unsigned int m = 0; m < k.size(); ++m)
                     M(j, l * k.size() + m) = std::exp(k[m] * s);
                 }
+              if (flux)
+                M(j, n_modes - 1) = 1.;
             }
           const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
           // Least squares (4.31), or (monotone) V_j >= 0, sum V_j = 1: the
@@ -436,7 +477,9 @@ namespace PeriDEAL
           // for equality constraints), then normalized exactly.
           Eigen::RowVectorXd V;
           const bool         monotone = prm.fit == "monotone";
-          if (prm.fit == "least squares" || prm.fit == "stabilized")
+          if (flux && monotone)
+            V = monotone_flux_fit(M, psi_dt);
+          else if (prm.fit == "least squares" || prm.fit == "stabilized")
             V = psi_dt * cod.pseudoInverse();
           else if (monotone)
             V = bounded_fit(M, psi_dt, 0., -1.);
@@ -446,7 +489,8 @@ namespace PeriDEAL
             {
               // Start from least squares; the monotone fit is the fallback
               // the blend moves to.
-              const Eigen::RowVectorXd Vm = bounded_fit(M, psi_dt, 0., -1.);
+              const Eigen::RowVectorXd Vm =
+                flux ? monotone_flux_fit(M, psi_dt) : bounded_fit(M, psi_dt, 0., -1.);
               for (unsigned int j = 0; j < cloud.size(); ++j)
                 {
                   update_ls.push_back(V[j]);
@@ -470,8 +514,10 @@ namespace PeriDEAL
           // (2D disc), so the guard is off by default and the PD near field
           // checks the one-step map itself (PdUnboundedDiffusion).
           // (The stabilized fit applies the l1 bound as a cap on its blend.)
-          const bool l1_ok = monotone || prm.fit == "stabilized" || vl1 <= prm.max_update_l1;
-          if (!(cond <= prm.max_condition_number) || !(vmax <= prm.max_update_norm) || !l1_ok)
+          // (The normal derivative's weights scale as 1/h: no norm guards;
+          // the near field's stability check decides.)
+          const bool l1_ok = monotone || prm.fit == "stabilized" || flux || vl1 <= prm.max_update_l1;
+          if (!(cond <= prm.max_condition_number) || !(flux || vmax <= prm.max_update_norm) || !l1_ok)
             {
               std::ostringstream v;
               v << "condition number " << cond << ", max |V_j| " << vmax << ", sum |V_j| " << vl1
@@ -517,6 +563,72 @@ namespace PeriDEAL
       theta[a] = th;
       for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
         update_vector[c] = (1. - th) * update_ls[c] + th * update_monotone[c];
+    }
+
+    template <int dim>
+    void
+    EbfDiffusionAbc<dim>::stabilize(const double                               l1_cap,
+                                    const unsigned int                         max_rounds,
+                                    const double                               threshold,
+                                    const std::function<double()>             &one_step_growth,
+                                    const std::function<double(unsigned int)> &iterate,
+                                    const MPI_Comm                             comm)
+    {
+      Assert(!theta.empty(), ExcMessage("stabilize needs the stabilized fit"));
+      const auto halfway = [this](const unsigned int a) {
+        const double th = theta[a];
+        set_blend(a, th >= 1. - 1. / 32. ? 1. : 0.5 * (1. + th));
+      };
+      const auto l1_norm = [this](const unsigned int a) {
+        double l1 = 0.;
+        for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+          l1 += std::abs(update_vector[c]);
+        return l1;
+      };
+      // The l1 cap first: on each cloud the smallest theta of the sequence
+      // 0, 1/2, 3/4, ..., 1 with sum_j |V_j| <= the cap.
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        while (l1_norm(a) > l1_cap && theta[a] != 1.)
+          halfway(a);
+      for (stats.stabilization_rounds = 0; stats.stabilization_rounds < max_rounds;
+           ++stats.stabilization_rounds)
+        {
+          if (one_step_growth() <= threshold)
+            break;
+          // The growing mode lives where |u| is large: every cloud whose
+          // points carry at least a tenth of the peak moves halfway.
+          std::vector<double> carried(absorbing.size(), 0.);
+          double              peak = 0.;
+          for (unsigned int a = 0; a < absorbing.size(); ++a)
+            {
+              for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+                carried[a] = std::max(carried[a], std::abs(iterate(cloud_index[c])));
+              peak = std::max(peak, carried[a]);
+            }
+          peak = Utilities::MPI::max(peak, comm);
+          for (unsigned int a = 0; a < absorbing.size(); ++a)
+            if (carried[a] >= 0.1 * peak)
+              halfway(a);
+        }
+      // The statistics of reinit describe the least-squares fit: redo the
+      // norms for the blended vectors in use.
+      types::global_dof_index n_blended = 0;
+      double                  max_blend = 0., max_norm = 0., max_l1 = 0.;
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
+        {
+          if (theta[a] > 0.)
+            {
+              ++n_blended;
+              max_blend = std::max(max_blend, theta[a]);
+            }
+          for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+            max_norm = std::max(max_norm, std::abs(update_vector[c]));
+          max_l1 = std::max(max_l1, l1_norm(a));
+        }
+      stats.n_blended       = Utilities::MPI::sum(n_blended, comm);
+      stats.max_blend       = Utilities::MPI::max(max_blend, comm);
+      stats.max_update_norm = Utilities::MPI::max(max_norm, comm);
+      stats.max_update_l1   = Utilities::MPI::max(max_l1, comm);
     }
 
     template <int dim>

@@ -27,6 +27,8 @@ namespace PeriDEAL
     {
       check_parameter(domain.has_signed_distance(), "Geometry/Domain", "without signed distance",
                       "a box or a ball (the absorbing layer needs the distance to the boundary)");
+      check_parameter(prm.imposed == "value", "Absorbing boundary/Imposed", prm.imposed,
+                      "value (the PD near field has no boundary flux)");
       disc.setup(domain, lattice);
       op = std::make_unique<DiffusionOperator<dim>>(disc, model);
       check_parameter(time_step > 0 && time_step <= op->critical_time_step(), "Time step", time_step,
@@ -150,80 +152,23 @@ namespace PeriDEAL
                                          const std::vector<bool> &in_clouds,
                                          const double             l1_cap)
     {
-      const MPI_Comm comm   = disc.get_mpi_communicator();
-      const auto    &points = abc.absorbing_points();
-      auto          &st     = abc.statistics();
-      Vector         u;
+      Vector u;
       // The random start is restricted to the clouds: a start over the
       // whole near field puts most of its norm into the slowly decaying
       // interior diffusion modes (1 - D dt (pi/R)^2 per step), which hide a
       // boundary mode growing by less than a few percent per step within
       // the check's steps (on the dx = 0.25 sphere a fresh start measured
       // 0.9996 for a map that diverged).
-      // The l1 cap first: on each cloud the smallest theta of the sequence
-      // 0, 1/2, 3/4, ..., 1 with sum_j |V_j| <= the cap.
-      for (unsigned int a = 0; a < points.size(); ++a)
-        for (;;)
-          {
-            double l1 = 0.;
-            for (const auto &[j, v] : abc.cloud(a))
-              l1 += std::abs(v);
-            const double th = abc.blend(a);
-            if (l1 <= l1_cap || th == 1.)
-              break;
-            abc.set_blend(a, th >= 1. - 1. / 32. ? 1. : 0.5 * (1. + th));
-          }
-      for (st.stabilization_rounds = 0; st.stabilization_rounds < max_rounds; ++st.stabilization_rounds)
-        {
-          random_vector(u);
-          for (unsigned int i = 0; i < disc.n_owned(); ++i)
-            if (!in_clouds[i])
-              u.local_element(i) = 0.;
-          const double growth = power_iteration(u, n_steps);
-          if (growth <= 1. + 1e-6)
-            break;
-          // The growing mode lives where |u| is large: every cloud whose
-          // points carry at least a tenth of the peak moves halfway to the
-          // monotone fit (theta = 1 - 2^-r; the last step goes to 1).
-          std::vector<double> carried(points.size(), 0.);
-          double              peak = 0.;
-          for (unsigned int a = 0; a < points.size(); ++a)
-            {
-              for (const auto &[j, v] : abc.cloud(a))
-                carried[a] = std::max(carried[a], std::abs(u.local_element(j)));
-              peak = std::max(peak, carried[a]);
-            }
-          peak = Utilities::MPI::max(peak, comm);
-          for (unsigned int a = 0; a < points.size(); ++a)
-            if (carried[a] >= 0.1 * peak)
-              {
-                const double th = abc.blend(a);
-                abc.set_blend(a, th >= 1. - 1. / 32. ? 1. : 0.5 * (1. + th));
-              }
-        }
-      // The statistics of reinit describe the least-squares fit: redo the
-      // norms for the blended vectors in use.
-      types::global_dof_index n_blended = 0;
-      double                  max_blend = 0., max_norm = 0., max_l1 = 0.;
-      for (unsigned int a = 0; a < points.size(); ++a)
-        {
-          if (abc.blend(a) > 0.)
-            {
-              ++n_blended;
-              max_blend = std::max(max_blend, abc.blend(a));
-            }
-          double l1 = 0.;
-          for (const auto &[j, v] : abc.cloud(a))
-            {
-              l1 += std::abs(v);
-              max_norm = std::max(max_norm, std::abs(v));
-            }
-          max_l1 = std::max(max_l1, l1);
-        }
-      st.n_blended       = Utilities::MPI::sum(n_blended, comm);
-      st.max_blend       = Utilities::MPI::max(max_blend, comm);
-      st.max_update_norm = Utilities::MPI::max(max_norm, comm);
-      st.max_update_l1   = Utilities::MPI::max(max_l1, comm);
+      const auto growth = [&]() {
+        random_vector(u);
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (!in_clouds[i])
+            u.local_element(i) = 0.;
+        return power_iteration(u, n_steps);
+      };
+      abc.stabilize(l1_cap, max_rounds, 1. + 1e-6, growth,
+                    [&u](const unsigned int j) { return u.local_element(j); },
+                    disc.get_mpi_communicator());
     }
 
     template <int dim>

@@ -67,6 +67,16 @@ namespace PeriDEAL
       else
         abc = Abc::EbfDiffusionAbc<dim>();
 
+      const bool flux = absorbing && abc_parameters.imposed == "normal derivative";
+      check_parameter(!flux || (prm.scheme == "forward Euler" && prm.lumped_mass), "FEM/Scheme",
+                      prm.scheme, "forward Euler with lumped mass for Imposed = normal derivative");
+      flux_weight.reinit(part);
+      flux_boundary = flux;
+      if (flux)
+        for (const unsigned int l : absorbing_dofs)
+          flux_weight.local_element(l) = prm.diffusivity * boundary_lumped.local_element(l) /
+                                         lumped.local_element(l);
+
       // System matrix: M (consistent explicit) or M + dt K (implicit), with
       // identity rows for the absorbing DoFs (their values are given).
       const bool explicit_lumped = prm.scheme == "forward Euler" && prm.lumped_mass;
@@ -105,6 +115,29 @@ namespace PeriDEAL
                             " (forward Euler bound 2/lambda_max(M^-1 K))");
         }
 
+      constexpr double   growth_threshold = 1. + 1e-5;
+      constexpr unsigned n_krylov         = 60;
+      if (absorbing && abc_parameters.fit == "stabilized")
+        {
+          // The blending of the PD near field, shared through
+          // EbfDiffusionAbc::stabilize, with this map: the decision by the
+          // Arnoldi radius of the check below (the power iteration of the
+          // non-normal map grows transiently although the map is stable),
+          // the clouds to blend located by the power iteration's iterate.
+          const unsigned int n_steps = std::max(abc_parameters.stability_check_steps, 100u);
+          const SavedState   saved   = save_state();
+          const auto         growth  = [&]() {
+            const double radius = arnoldi_spectral_radius(n_steps / 4, n_krylov);
+            if (radius > growth_threshold)
+              power_iterate(n_steps);
+            return radius;
+          };
+          abc.stabilize(abc_parameters.max_update_l1, abc_parameters.max_stabilization_rounds,
+                        growth_threshold, growth, [this](const unsigned int j) { return C.local_element(j); },
+                        near_field.comm);
+          restore_state(saved);
+        }
+
       // The ABC extrapolates explicitly over dt: even with backward Euler
       // the one-step map grows beyond a time step that depends on the cloud
       // (measured on squares, Q1, d_inf = 2h, Delta k = 2/d_inf: stable up
@@ -124,8 +157,6 @@ namespace PeriDEAL
       // (equal to the dense radius to 4 digits) and 1 - 8e-6 .. 1 - 4e-4
       // in 1D (never above 1 for a stable map in the tests), so the
       // threshold is 1 + 1e-5 per step (a doubling in 7e4 steps).
-      constexpr double   growth_threshold = 1. + 1e-5;
-      constexpr unsigned n_krylov         = 60;
       stability_growth = 0.;
       if (absorbing && abc_parameters.stability_check_steps > 0)
         {
@@ -208,6 +239,10 @@ namespace PeriDEAL
           C.zero_out_ghost_values();
           solver->solve(C, rhs);
         }
+      else if (flux_boundary)
+        // The EBF normal derivative as the flux of the boundary DoF's row.
+        for (unsigned int a = 0; a < absorbing.size(); ++a)
+          C.local_element(absorbing[a]) += dt * flux_weight.local_element(absorbing[a]) * boundary_values[a];
       else
         for (unsigned int a = 0; a < absorbing.size(); ++a)
           C.local_element(absorbing[a]) = boundary_values[a];
@@ -223,7 +258,16 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::power_iteration_growth(const unsigned int n_steps)
     {
-      const SavedState saved = save_state();
+      const SavedState saved  = save_state();
+      const double     growth = power_iterate(n_steps);
+      restore_state(saved);
+      return growth;
+    }
+
+    template <int dim>
+    double
+    FemDiffusion<dim>::power_iterate(const unsigned int n_steps)
+    {
       random_cloud_start();
       double             log_growth = 0.;
       const unsigned int window     = std::max(1u, n_steps / 4);
@@ -236,7 +280,6 @@ namespace PeriDEAL
           C /= g;
           C.update_ghost_values();
         }
-      restore_state(saved);
       return std::exp(log_growth / window);
     }
 

@@ -62,6 +62,19 @@ namespace PeriDEAL
        * limits the negative weights that extrapolation needs).
        */
       double l1_excess = 0.5;
+      /**
+       * What the clouds give the near field. "value": the absorbing value
+       * at t^{n+1} (4.31), imposed as a Dirichlet value. "normal
+       * derivative" (FEM, forward Euler with lumped mass): the outward
+       * normal derivative at t^n, fitted to d psi/dn(x_i) = k d.n of the
+       * modes (and 0 for the constant), which enters the boundary DoF's own
+       * FEM row as the flux D dC/dn (a Neumann condition from the EBFs).
+       * With the monotone fit dC/dn = sum_{j != i} P_j (C_j - C_i) - q C_i,
+       * P_j, q >= 0 (nonnegative least squares): the row stays an M-matrix
+       * row with a sink (a Robin-type condition), so that, unlike a convex
+       * combination, the boundary value can fall below its cloud's.
+       */
+      std::string imposed = "value";
       /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
       double lower_bound = -1.;
       /**
@@ -224,6 +237,27 @@ namespace PeriDEAL
       {
         return theta.empty() ? 0. : theta[a];
       }
+
+      /**
+       * The "stabilized" fit's blending, shared by every near field. First
+       * each cloud with sum_j |V_j| > @p l1_cap takes the smallest theta of
+       * 0, 1/2, 3/4, ..., 1 that brings it below the cap. Then at most
+       * @p max_rounds rounds: @p one_step_growth() measures the growth per
+       * step of the near field's one-step map (with the current blend) and
+       * leaves a growing iterate behind, read through @p iterate(local
+       * index, ghosts included); while the growth exceeds @p threshold, every
+       * cloud whose points carry at least a tenth of the iterate's peak
+       * (over all ranks) moves halfway to the monotone fit (theta = 1 -
+       * 2^-r; the last step goes to 1). Ends by recomputing the statistics'
+       * blend and norm fields for the vectors in use.
+       */
+      void
+      stabilize(const double                                 l1_cap,
+                const unsigned int                           max_rounds,
+                const double                                 threshold,
+                const std::function<double()>               &one_step_growth,
+                const std::function<double(unsigned int)>   &iterate,
+                const MPI_Comm                               comm);
       /** Statistics of all clouds. */
       CloudStatistics &
       statistics()

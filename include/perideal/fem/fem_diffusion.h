@@ -63,7 +63,14 @@ namespace PeriDEAL
 
       /**
        * Distribute DoFs, assemble M and K, build the ABC (for @p boundary
-       * absorbing; local dispersion with D), interpolate @p initial.
+       * absorbing; local dispersion with D), interpolate @p initial. With
+       * EbfParameters::imposed "value" the absorbing DoFs get the EBF values
+       * as Dirichlet rows; with "normal derivative" (forward Euler, lumped
+       * mass) they keep their FEM rows and the EBF normal derivative enters
+       * as the flux D dC/dn (fit "monotone": dC/dn = sum_j P_j (C_j - C_i)
+       * - q C_i with P, q >= 0, a Robin-type sink that keeps the row an
+       * M-matrix row). The "stabilized" fit blends by
+       * Abc::EbfDiffusionAbc::stabilize with this map.
        * Throws ParameterError if the explicit step is unstable, or (absorbing,
        * EbfParameters::stability_check_steps > 0) if the one-step map with
        * the ABC grows (spectral radius above 1 + 1e-5 by
@@ -151,6 +158,13 @@ namespace PeriDEAL
       double abc_seconds = 0., step_seconds = 0.;
 
     private:
+      /**
+       * C = @p n_steps steps of the normalized power iteration from the
+       * random cloud start (ghosts updated); returns the growth per step
+       * over the last quarter.
+       */
+      double
+      power_iterate(const unsigned int n_steps);
       /** C = the pseudo-random start on the owned cloud DoFs (seeded by global id), normalized. */
       void
       random_cloud_start();
@@ -181,6 +195,10 @@ namespace PeriDEAL
       NearFieldLayout<dim>           near_field;
       TrilinosWrappers::SparseMatrix mass, stiffness, system;
       DistributedVector              lumped, boundary_lumped;
+      /** Imposed = normal derivative: D (boundary mass) / (lumped mass) of the absorbing DoFs, else 0. */
+      DistributedVector              flux_weight;
+      /** Imposed = normal derivative: the absorbing DoFs keep their FEM rows and get the EBF flux. */
+      bool                           flux_boundary = false;
       SolverControl                  solver_control;
       std::unique_ptr<TrilinosWrappers::SolverDirect> solver;
       Abc::EbfDiffusionAbc<dim>      abc;
