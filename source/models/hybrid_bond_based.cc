@@ -2,6 +2,7 @@
 #include <perideal/models/hybrid_bond_based.h>
 #include <perideal/models/lattice_sweep_kernel.h>
 
+#include <algorithm>
 #include <ctime>
 #include <immintrin.h>
 #include <complex>
@@ -136,6 +137,123 @@ namespace PeriDEAL
       for (unsigned int d = 1; d < dim; ++d)
         l2 = _mm512_fmadd_pd(y[d], y[d], l2);
       return l2;
+    }
+
+    /** The operations of the exact switching test on W = 8 (512-bit) or 4 (256-bit) lanes. */
+    template <int W>
+    struct LaneVector;
+    template <>
+    struct LaneVector<8>
+    {
+      using type = __m512d;
+    };
+    template <>
+    struct LaneVector<4>
+    {
+      using type = __m256d;
+    };
+    template <int W>
+    struct Lanes
+    {
+      static constexpr bool wide = W == 8;
+      using V                    = typename LaneVector<W>::type;
+      static V load(const double *a)
+      {
+        if constexpr (wide)
+          return _mm512_loadu_pd(a);
+        else
+          return _mm256_loadu_pd(a);
+      }
+      static V sub(const V a, const V b)
+      {
+        if constexpr (wide)
+          return _mm512_sub_pd(a, b);
+        else
+          return _mm256_sub_pd(a, b);
+      }
+      static V mul(const V a, const V b)
+      {
+        if constexpr (wide)
+          return _mm512_mul_pd(a, b);
+        else
+          return _mm256_mul_pd(a, b);
+      }
+      static V fmadd(const V a, const V b, const V c)
+      {
+        if constexpr (wide)
+          return _mm512_fmadd_pd(a, b, c);
+        else
+          return _mm256_fmadd_pd(a, b, c);
+      }
+      static V max(const V a, const V b)
+      {
+        if constexpr (wide)
+          return _mm512_max_pd(a, b);
+        else
+          return _mm256_max_pd(a, b);
+      }
+      /** q where m is 0, max(q, x) where it is 1. */
+      static V mask_max(const V q, const __mmask8 m, const V x)
+      {
+        if constexpr (wide)
+          return _mm512_mask_max_pd(q, m, q, x);
+        else
+          return _mm256_mask_max_pd(q, m, q, x);
+      }
+      static V set1(const double a)
+      {
+        if constexpr (wide)
+          return _mm512_set1_pd(a);
+        else
+          return _mm256_set1_pd(a);
+      }
+    };
+
+    /**
+     * The exact switching test's q = max |y|^2 / T^2 = max |y|^2 iL2[f]
+     * over the offsets grp[0, n_g) of the W lanes at box position L (0 in a
+     * lane without an alive bond), y = p(L + o_f) - p(L), |y|^2 by the
+     * expression of length2() (the same bits at either width). A bond is
+     * alive in the lanes of (bits[f] >> shift) & lanes; @p grp null: all
+     * offsets f < n_g in order (no indirection through the table). Four independent
+     * maxima in named registers, unrolled by hand (one chain is latency
+     * bound; with qm[g % 4] GCC kept the maxima on the stack); the maximum
+     * is exact, so the grouping does not change q.
+     */
+    template <int dim, int W, bool all>
+    inline typename Lanes<W>::V
+    max_ratio(const double *p, const std::size_t N, const std::size_t L, const std::int64_t *offset,
+              const double *iL2, const std::uint8_t *bits, const unsigned int shift,
+              const __mmask8 lanes, const unsigned int *grp, const unsigned int n_g)
+    {
+      using S = Lanes<W>;
+      typename S::V pi[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        pi[d] = S::load(p + d * N + L);
+      const auto step = [&](typename S::V &q, const unsigned int g) {
+        const unsigned int f = all ? g : grp[g];
+        const __mmask8 alive = __mmask8((bits[f] >> shift) & lanes);
+        typename S::V  y     = S::sub(S::load(p + L + offset[f]), pi[0]);
+        typename S::V  l2    = S::mul(y, y);
+        for (unsigned int d = 1; d < dim; ++d)
+          {
+            y  = S::sub(S::load(p + d * N + L + offset[f]), pi[d]);
+            l2 = S::fmadd(y, y, l2);
+          }
+        q = S::mask_max(q, alive, S::mul(l2, S::set1(iL2[f])));
+      };
+      typename S::V q0 = S::set1(0.), q1 = q0, q2 = q0, q3 = q0;
+      unsigned int  g  = 0;
+      for (; g + 4 <= n_g; g += 4)
+        {
+          step(q0, g);
+          step(q1, g + 1);
+          step(q2, g + 2);
+          step(q3, g + 3);
+        }
+      for (; g < n_g; ++g)
+        step(q0, g);
+      return S::max(S::max(q0, q1), S::max(q2, q3));
     }
 #endif
   } // namespace
@@ -465,6 +583,15 @@ namespace PeriDEAL
           ++fill_runs.back()[2];
         else
           fill_runs.push_back({{i, sweep_position[i], 1}});
+      // The rows of the stencil: p is read in [L0 + ro - R, L0 + ro + R + 8).
+      const int W = 2 * box_radius + 1;
+      p_row_offsets.assign(1, 0);
+      for (unsigned int f = 0; f < sweep_offset.size(); ++f)
+        p_row_offsets.push_back(sweep_offset[f] - (int(sweep_box[f] % W) - box_radius));
+      std::sort(p_row_offsets.begin(), p_row_offsets.end());
+      p_row_offsets.erase(std::unique(p_row_offsets.begin(), p_row_offsets.end()), p_row_offsets.end());
+      p_stamp.assign((8 * sweep_n_vectors + p_chunk - 1) / p_chunk, 0);
+      p_epoch = 0;
     }
     sweep_on         = true;
 
@@ -646,6 +773,39 @@ namespace PeriDEAL
   }
 
   template <int dim>
+  template <typename F>
+  void
+  HybridBondBasedModel<dim>::for_each_p_chunk(const std::int64_t L0, const F &f) const
+  {
+    const std::int64_t n8 = 8 * std::int64_t(sweep_n_vectors), C = p_chunk;
+    for (const std::int64_t ro : p_row_offsets)
+      {
+        const std::int64_t lo = std::max<std::int64_t>(0, L0 + ro - box_radius),
+                           hi = std::min<std::int64_t>(n8, L0 + ro + box_radius + 8);
+        for (std::int64_t c = lo / C; c * C < hi && lo < hi; ++c)
+          f(std::size_t(c));
+      }
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::fill_p_chunk(const std::size_t c)
+  {
+    // Off the nodes x - x_c and u are 0 (as p): the whole chunk.
+    const std::size_t N = sweep_n_alloc, begin = c * p_chunk,
+                      end = std::min(begin + p_chunk, 8 * std::size_t(sweep_n_vectors));
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double *__restrict x = sweep_x0.data() + sweep_pad + d * N;
+        const double *__restrict u = sweep_u.data() + sweep_pad + d * N;
+        double *__restrict p       = sweep_p.data() + sweep_pad + d * N;
+        for (std::size_t L = begin; L < end; ++L)
+          p[L] = x[L] + u[L];
+      }
+    p_stamp[c] = p_epoch;
+  }
+
+  template <int dim>
   void
   HybridBondBasedModel<dim>::update_row_lists()
   {
@@ -695,6 +855,13 @@ namespace PeriDEAL
         }
       else
         standard_start_lanes.back() |= std::uint8_t(1u << (L - standard_start.back()));
+    std::vector<std::uint8_t> read(p_stamp.size(), 0);
+    for (const std::uint32_t L0 : standard_start)
+      for_each_p_chunk(L0, [&](const std::size_t c) { read[c] = 1; });
+    standard_chunks.clear();
+    for (std::size_t c = 0; c < read.size(); ++c)
+      if (read[c])
+        standard_chunks.push_back(c);
   }
 
   template <int dim>
@@ -876,6 +1043,10 @@ namespace PeriDEAL
         const __mmask8    lanes   = wls_lanes[v];
         const unsigned    classes = lip ? 1u : test_lanes[v];
         const std::size_t L0      = 8 * std::size_t(v);
+        for_each_p_chunk(L0, [&](const std::size_t c) {
+          if (p_stamp[c] != p_epoch)
+            fill_p_chunk(c);
+        });
         __m512d pi[dim];
         for (unsigned int d = 0; d < dim; ++d)
           pi[d] = _mm512_loadu_pd(p + d * N + L0);
@@ -901,63 +1072,18 @@ namespace PeriDEAL
             // First q = max |y|^2 / T^2 only; the (rare) vectors with
             // q >= 1 - 1e-12 are scanned again for the bonds with
             // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
-            // Four independent maxima (the chain of one is latency bound).
-            // The four maxima in named registers, unrolled by hand, and the
-            // tables in locals: with qm[g % 4] GCC kept the maxima on the
-            // stack (a store and reload per bond) and reloaded the tables.
-            // The maximum is exact, so the grouping does not change q.
-            const unsigned int  n_g = group.size();
-            const unsigned int *grp = group.data();
-            __m512d             qmax;
+            // The lattice bound's group is every offset in order.
+            __m512d qmax;
             if (half)
               {
-                const std::size_t L4 = L0 + 4 * h;
-                const __mmask8    l4 = tl >> (4 * h);
-                const __m256d     p0 = _mm256_loadu_pd(p + L4), p1 = _mm256_loadu_pd(p + N + L4);
-                const auto        q4_step = [&](__m256d &q, const unsigned int f) {
-                  const __mmask8 alive = (bits[f] >> (4 * h)) & l4;
-                  const __m256d  y0    = _mm256_sub_pd(_mm256_loadu_pd(p + L4 + offset[f]), p0);
-                  const __m256d  y1    = _mm256_sub_pd(_mm256_loadu_pd(p + N + L4 + offset[f]), p1);
-                  // |y|^2 by the expression of length2() (bitwise the 512-bit value).
-                  const __m256d l2 = _mm256_fmadd_pd(y1, y1, _mm256_mul_pd(y0, y0));
-                  q = _mm256_mask_max_pd(q, alive, q, _mm256_mul_pd(l2, _mm256_set1_pd(iL2[f])));
-                };
-                __m256d      r0 = _mm256_setzero_pd(), r1 = r0, r2 = r0, r3 = r0;
-                unsigned int g  = 0;
-                for (; g + 4 <= n_g; g += 4)
-                  {
-                    q4_step(r0, grp[g]);
-                    q4_step(r1, grp[g + 1]);
-                    q4_step(r2, grp[g + 2]);
-                    q4_step(r3, grp[g + 3]);
-                  }
-                for (; g < n_g; ++g)
-                  q4_step(r0, grp[g]);
-                const __m256d q4 = _mm256_max_pd(_mm256_max_pd(r0, r1), _mm256_max_pd(r2, r3));
-                qmax             = h ? _mm512_insertf64x4(_mm512_setzero_pd(), q4, 1) :
-                                       _mm512_zextpd256_pd512(q4);
+                const __m256d q4 = max_ratio<dim, 4, true>(p, N, L0 + 4 * h, offset, iL2, bits, 4 * h,
+                                                           __mmask8(tl >> (4 * h)), nullptr, group.size());
+                qmax = h ? _mm512_insertf64x4(_mm512_setzero_pd(), q4, 1) : _mm512_zextpd256_pd512(q4);
               }
+            else if (lip)
+              qmax = max_ratio<dim, 8, true>(p, N, L0, offset, iL2, bits, 0, lanes, nullptr, group.size());
             else
-            {
-            const auto          q_step = [&](__m512d &q, const unsigned int f) {
-              const __mmask8 alive = bits[f] & lanes;
-              __m512d        y[dim];
-              const __m512d  l2 = lane_bonds<dim>(p, N, L0, offset[f], pi, y);
-              q = _mm512_mask_max_pd(q, alive, q, _mm512_mul_pd(l2, _mm512_set1_pd(iL2[f])));
-            };
-            __m512d      q0 = _mm512_setzero_pd(), q1 = q0, q2 = q0, q3 = q0;
-            unsigned int g  = 0;
-            for (; g + 4 <= n_g; g += 4)
-              {
-                q_step(q0, grp[g]);
-                q_step(q1, grp[g + 1]);
-                q_step(q2, grp[g + 2]);
-                q_step(q3, grp[g + 3]);
-              }
-            for (; g < n_g; ++g)
-              q_step(q0, grp[g]);
-            qmax = _mm512_max_pd(_mm512_max_pd(q0, q1), _mm512_max_pd(q2, q3));
-            }
+              qmax = max_ratio<dim, 8, false>(p, N, L0, offset, iL2, bits, 0, lanes, group.data(), group.size());
             if (__builtin_expect(
                   _mm512_cmp_pd_mask(qmax, _mm512_set1_pd(1. - 1e-12), _CMP_GE_OQ) != 0, 0))
               for (const unsigned int f : group)
@@ -1120,6 +1246,9 @@ namespace PeriDEAL
     // offset (sweep_broken.emplace_back may alias the members).
     const std::int64_t *offset = sweep_offset.data();
     const double       *kb = sweep_k.data(), *kr = sweep_kr.data(), *t2 = sweep_t2.data();
+    for (const std::uint32_t c : standard_chunks)
+      if (p_stamp[c] != p_epoch)
+        fill_p_chunk(c);
     sweep_broken.clear();
     for (std::size_t k = 0; k < standard_start.size(); ++k)
       {
@@ -1278,25 +1407,22 @@ namespace PeriDEAL
         if (lip_swap_pending)
           std::swap(sweep_u, lip_prev);
         lip_swap_pending = false;
+        // u into the box; p = (x - x_c) + u only in the chunks read, just
+        // before they are read (fill_p_chunk(); KW dx = 0.25: 75 % of the
+        // chunks per evaluation on average, all of them in the last ~200 of
+        // the 705 steps, when exact tests occur everywhere).
+        if (++p_epoch == 0)
+          {
+            std::fill(p_stamp.begin(), p_stamp.end(), 0);
+            p_epoch = 1;
+          }
         const std::size_t N = sweep_n_alloc;
         for (unsigned int d = 0; d < dim; ++d)
           {
             const double *ud = u[d].begin();
-            const double *xd = sweep_x0.data() + sweep_pad + d * N;
-            double       *pd = sweep_p.data() + sweep_pad + d * N;
             double       *vd = sweep_u.data() + sweep_pad + d * N;
             for (const auto &[i0, L0, n] : fill_runs)
-              {
-                const double *__restrict ui = ud + i0;
-                const double *__restrict xi = xd + L0;
-                double *__restrict pi       = pd + L0;
-                double *__restrict vi       = vd + L0;
-                for (std::uint32_t k = 0; k < n; ++k)
-                  {
-                    pi[k] = xi[k] + ui[k];
-                    vi[k] = ui[k];
-                  }
-              }
+              std::copy(ud + i0, ud + i0 + n, vd + L0);
           }
       }
     else

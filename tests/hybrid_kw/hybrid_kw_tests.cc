@@ -575,6 +575,98 @@ namespace
               " (StretchBudget)");
   }
 
+  // (h) The fast switching test (lattice bound, p formed only where read)
+  // against the exact test of every bond at every step, on KW at CI size
+  // (dx = 1 mm, delta = 4 mm, 20,000 nodes) on MPI_COMM_WORLD (1 or 2
+  // ranks): per node the same switch evaluation (hence the same switched
+  // set), bitwise the same damage and displacement.
+  void
+  kw_equivalence()
+  {
+    const double dx = 1., delta = 4., T = 87.5e-6;
+    auto         pf = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-equivalence");
+    auto         pe = pf;
+    pe.hybrid.switching_bound = false;
+    pe.output_directory       = "kw-equivalence-every-step";
+    MechanicsSolver<2> fast(MPI_COMM_WORLD, pf), every(MPI_COMM_WORLD, pe);
+    fast.run();
+    every.run();
+    const auto *hf = fast.hybrid_model(), *he = every.hybrid_model();
+    // Per id on this rank: switch evaluation, damage, displacement (both
+    // runs partition the plate alike; an id owned in one run only counts as
+    // a difference).
+    struct State
+    {
+      int    switched;
+      double damage, u[2];
+    };
+    const auto states = [](const MechanicsSolver<2> &s) {
+      std::map<types::particle_index, State> m;
+      const auto dmg = damage_by_id(s);
+      const auto &disc = s.discretization();
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        m[disc.id[i]] = {s.hybrid_model()->switch_evaluation()[i], dmg.at(disc.id[i]),
+                         {s.integrator().displacement[0].local_element(i),
+                          s.integrator().displacement[1].local_element(i)}};
+      return m;
+    };
+    const auto   sf = states(fast), se = states(every);
+    unsigned int n_switched = 0, switch_differ = 0, missing = 0;
+    double       damage_diff = 0., u_diff = 0., u_max = 0.;
+    for (const auto &[id, a] : sf)
+      {
+        const auto it = se.find(id);
+        if (it == se.end())
+          {
+            ++missing;
+            continue;
+          }
+        const State &b = it->second;
+        n_switched += a.switched >= 0;
+        switch_differ += a.switched != b.switched;
+        damage_diff = std::max(damage_diff, std::abs(a.damage - b.damage));
+        for (unsigned int d = 0; d < 2; ++d)
+          {
+            u_diff = std::max(u_diff, std::abs(a.u[d] - b.u[d]));
+            u_max  = std::max(u_max, std::abs(b.u[d]));
+          }
+      }
+    const MPI_Comm comm = MPI_COMM_WORLD;
+    n_switched          = Utilities::MPI::sum(n_switched, comm);
+    switch_differ       = Utilities::MPI::sum(switch_differ, comm);
+    missing             = Utilities::MPI::sum(missing + unsigned(sf.size() != se.size()), comm);
+    damage_diff         = Utilities::MPI::max(damage_diff, comm);
+    u_diff              = Utilities::MPI::max(u_diff, comm);
+    u_max               = Utilities::MPI::max(u_max, comm);
+    const std::uint64_t tests_fast = Utilities::MPI::sum(hf->n_exact_node_tests(), comm),
+                        tests_every = Utilities::MPI::sum(he->n_exact_node_tests(), comm);
+    const unsigned int n_ranks = Utilities::MPI::n_mpi_processes(comm);
+    check(missing == 0, "the same nodes owned in both runs (" + std::to_string(n_ranks) + " rank(s))");
+    check(n_switched > 1000 && switch_differ == 0 &&
+            hf->n_switch_events() == he->n_switch_events() &&
+            hf->n_standard_nodes() == he->n_standard_nodes(),
+          std::to_string(n_switched) + " switched nodes, each at the same force evaluation as "
+            "with the exact test of every bond (" + std::to_string(switch_differ) + " differ; " +
+            std::to_string(hf->n_switch_events()) + " / " + std::to_string(he->n_switch_events()) +
+            " switch events)");
+    check(hf->n_overstretched_bonds() == he->n_overstretched_bonds() &&
+            fast.model().n_broken_bonds() == every.model().n_broken_bonds() &&
+            fast.model().n_broken_bonds() > 0,
+          "broken bonds " + std::to_string(fast.model().n_broken_bonds()) + " / " +
+            std::to_string(every.model().n_broken_bonds()));
+    check(damage_diff == 0. && u_diff == 0. && u_max > 0.,
+          "max |damage difference| = " + sci(damage_diff) + ", max |u difference| = " +
+            sci(u_diff) + " (max |u| = " + sci(u_max) + ")");
+    // The fast path is the one under test: the lattice sweep with its
+    // bound (AVX-512; else the portable rows with StretchBudget) skips most
+    // exact node tests.
+    if (root())
+      std::cout << "  lattice sweep: " << (hf->uses_lattice_sweep() ? "yes" : "no")
+                << ", exact node tests " << tests_fast << " (fast) / " << tests_every
+                << " (every step)" << std::endl;
+    check(tests_fast < 0.25 * tests_every, "most exact node tests skipped");
+  }
+
   // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
   // horizon of the boundary or two of a pre-crack). Its area is a band
   // whose width is proportional to delta, so the fraction depends on delta,
@@ -616,5 +708,6 @@ main(int argc, char **argv)
               {"initial_fraction", initial_fraction},
               {"kw_classes", kw_classes},
               {"kw_lattice", kw_lattice},
+              {"kw_equivalence", kw_equivalence},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

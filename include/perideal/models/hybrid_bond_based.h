@@ -123,7 +123,9 @@ namespace PeriDEAL
    *
    * Lattice sweeps (AVX-512, dim > 1, uniform bonds per lattice offset,
    * uses_lattice_sweep()): p = x - x_c + u and u are laid out over the box
-   * of lattice positions and every row runs over the (signed) stencil
+   * of lattice positions (u copied every evaluation, p formed only in the
+   * chunks of the box that the Omega_s rows and the exact tests read, with
+   * the same bits as everywhere) and every row runs over the (signed) stencil
    * offsets, eight consecutive positions at a time, with per-offset bits
    * for the unbroken bonds: the Omega_s rows (PMB force and breaking, the
    * arithmetic of BondBasedOperator's AVX-512 loops), the exact switching
@@ -378,6 +380,16 @@ namespace PeriDEAL
     /** The sweep versions of the switching test and of the rows. */
     std::uint64_t
     sweep_switching_test();
+    /** Form p in the chunk @p c of the box (from sweep_x0 and sweep_u). */
+    void
+    fill_p_chunk(const std::size_t c);
+    /**
+     * Call @p f with every chunk of p that the rows of the eight box
+     * positions from @p L0 read.
+     */
+    template <typename F>
+    void
+    for_each_p_chunk(const std::int64_t L0, const F &f) const;
     /** The lattice bound: advance it to the current sweep_u, mark the vectors to test. */
     void
     lattice_bound_vectors();
@@ -470,6 +482,17 @@ namespace PeriDEAL
     std::vector<double> sweep_p, sweep_u;
     /** x - x_c over the box (layout of sweep_p). */
     std::vector<double> sweep_x0;
+    /**
+     * p = (x - x_c) + u is formed only where it is read, by chunks of
+     * p_chunk box positions: around the Omega_s rows and the vectors of
+     * exact tests (bitwise the value of a full copy). Per chunk, the
+     * evaluation of its last fill; the chunks the Omega_s rows read; the
+     * offsets of the stencil's rows (an offset without its x part).
+     */
+    static constexpr std::size_t p_chunk = 64;
+    std::vector<std::uint32_t>   p_stamp, standard_chunks;
+    std::vector<std::int64_t>    p_row_offsets;
+    std::uint32_t                p_epoch = 0;
     /** Runs (first local node, its box position, length) of consecutive nodes at consecutive positions. */
     std::vector<std::array<std::uint32_t, 3>> fill_runs;
     /**
