@@ -769,21 +769,7 @@ namespace PeriDEAL
     {
       u_new.resize(absorbing.size());
       v_new.resize(absorbing.size());
-      compute(0, absorbing.size(), u, u_old, v, v_old, u_new.data(), v_new.data());
-    }
-
-    template <int dim>
-    void
-    EbfWaveAbc<dim>::compute(const unsigned int begin,
-                             const unsigned int end,
-                             const double      *u,
-                             const double      *u_old,
-                             const double      *v,
-                             const double      *v_old,
-                             double            *u_new,
-                             double            *v_new) const
-    {
-      for (unsigned int a = begin; a < end; ++a)
+      for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
           double su = 0., sv = 0.;
           for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
@@ -852,7 +838,6 @@ namespace PeriDEAL
       spectral_radius = 0.;
       u_prev.clear();
       v_half.clear();
-      abc_ready = false;
       for (Vector *x : {&u, &v, &a, &Lu})
         disc.initialize_vector(*x);
       for (unsigned int i = 0; i < disc.n_owned(); ++i)
@@ -995,28 +980,15 @@ namespace PeriDEAL
       static const std::vector<unsigned int> none;
       const bool                             use_abc = absorbing && !skip_abc;
       const std::vector<unsigned int>       &nodes   = use_abc ? abc.absorbing_points() : none;
-      const double half      = 0.5 * dt;
+      const double                           half    = 0.5 * dt;
       // (4.82) from the levels n and n-1 (ghosts of u, v are current).
-      const bool overlap = use_abc && overlap_abc;
-      if (use_abc && !overlap)
+      if (use_abc)
         {
           abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
           for (const unsigned int j : abc.cloud_points())
             {
               u_old[j] = u.begin()[j];
               v_old[j] = v.begin()[j];
-            }
-        }
-      else if (overlap)
-        {
-          // u_abc comes from the last sweep unless the state was set anew.
-          if (!abc_ready)
-            abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
-          v_now.resize(u_old.size());
-          for (const unsigned int j : abc.cloud_points())
-            {
-              u_old[j] = u.begin()[j];
-              v_now[j] = v.begin()[j];
             }
         }
       const auto abc_end = clock::now();
@@ -1034,10 +1006,7 @@ namespace PeriDEAL
         uu[nodes[c]] = u_abc[c];
       t += dt;
       u.update_ghost_values();
-      if (overlap)
-        apply_operator_with_abc();
-      else
-        apply_operator();
+      apply_operator();
       pml_band.apply(true, {{u.begin()}}, {{Lu.begin()}});
       // Trapezoidal damping: v^{n+1/2} - v^{n-1/2} = dt L u^n - dt D (v^{n+1/2}
       // + v^{n-1/2}), so the half-step energy decays for any D >= 0.
@@ -1051,13 +1020,6 @@ namespace PeriDEAL
       const auto set_start = clock::now();
       for (unsigned int c = 0; c < nodes.size(); ++c)
         vv[nodes[c]] = v_abc[c];
-      if (overlap)
-        {
-          // Level n becomes the old level of the next step's v half.
-          std::swap(u_abc, u_next);
-          std::swap(v_old, v_now);
-          abc_ready = true;
-        }
       if (use_abc)
         v.update_ghost_values();
       const auto end = clock::now();
@@ -1086,7 +1048,6 @@ namespace PeriDEAL
       const std::vector<double> bm0 = pml_band.bond_memory, nm0 = pml_band.node_memory;
       const double              t0 = t, abc0 = abc_seconds, step0 = step_seconds;
       const auto                set_state = [&](const std::vector<double> &x) {
-        abc_ready = false;
         for (unsigned int i = 0; i < n; ++i)
           {
             u.local_element(i) = x[i];
@@ -1146,7 +1107,6 @@ namespace PeriDEAL
       t            = t0;
       abc_seconds  = abc0;
       step_seconds = step0;
-      abc_ready    = false;
       return m;
     }
 
@@ -1256,33 +1216,6 @@ namespace PeriDEAL
     PdUnboundedWave<dim>::apply_operator()
     {
       op->apply(u, Lu);
-      const double *uu = u.begin();
-      double       *lu = Lu.begin();
-      for (const auto &[i, j, w] : broken)
-        lu[i] -= w * (uu[j] - uu[i]);
-    }
-
-    template <int dim>
-    void
-    PdUnboundedWave<dim>::apply_operator_with_abc()
-    {
-      // Blocks of ~1,000 rows (E14: 33 blocks of the 33,949 rows, each
-      // followed by the sums of ~115 of the 3,800 absorbing nodes): the
-      // hardware overlaps the sums' coefficient loads with the row loop
-      // around them. (Software prefetching the next block's coefficients
-      // inside the row loop was slower: doc/benchmarks.md, session 10.)
-      const unsigned int n = disc.n_owned(), n_abc = abc.absorbing_points().size();
-      const unsigned int n_blocks = std::max(1u, std::min(n_abc, n / abc_block_rows));
-      u_next.resize(n_abc);
-      v_abc.resize(n_abc);
-      for (unsigned int b = 0; b < n_blocks; ++b)
-        {
-          const unsigned int first = std::size_t(n_abc) * b / n_blocks,
-                             last  = std::size_t(n_abc) * (b + 1) / n_blocks;
-          op->apply_row_range(u, Lu, std::size_t(n) * b / n_blocks, std::size_t(n) * (b + 1) / n_blocks);
-          abc.compute(first, last, u.begin(), u_old.data(), v_now.data(), v_old.data(), u_next.data(),
-                      v_abc.data());
-        }
       const double *uu = u.begin();
       double       *lu = Lu.begin();
       for (const auto &[i, j, w] : broken)

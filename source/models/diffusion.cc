@@ -52,26 +52,6 @@ namespace PeriDEAL
         s += wi[k] * c[ci[k]];
       return s;
     }
-
-    // One row of linear diffusion, kappa (sum_j w_ij c_j - (sum_j w_ij) c_i):
-    // the single definition behind apply() and apply_row_range().
-    inline double
-    linear_row(const std::int32_t  *col,
-               const std::uint64_t *row_start,
-               const std::uint64_t *table,
-               const double        *gw,
-               const double        *row_sum,
-               const double         kappa,
-               const double        *c,
-               const unsigned int   i)
-    {
-      const std::int32_t *ci = col + row_start[i];
-      const double       *wi = gw + table[i];
-      const unsigned int  m  = row_start[i + 1] - row_start[i];
-      const double        s  = m < 1024 ? weighted_row_sum_short(ci, wi, m, c) :
-                                          weighted_row_sum_long(ci, wi, m, c);
-      return kappa * (s - row_sum[i] * c[i]);
-    }
   } // namespace
 
   void
@@ -254,8 +234,13 @@ namespace PeriDEAL
       {
         const double kappa = kappa_table[0];
         for_standard_rows([&](const unsigned int i) {
-          r[i] = linear_row(col, row_start, table, gw, row_sum.data(), kappa, c, i);
-        });
+            const std::int32_t *ci = col + row_start[i];
+            const double       *wi = gw + table[i];
+            const unsigned int  m  = row_start[i + 1] - row_start[i];
+            const double        s  = m < 1024 ? weighted_row_sum_short(ci, wi, m, c) :
+                                                weighted_row_sum_long(ci, wi, m, c);
+            r[i] = kappa * (s - row_sum[i] * c[i]);
+          });
         if (wls) // Omega_w: the WLS rows (weights carry kappa), same short-row kernel
           for (unsigned int k = 0; k < wls->node.size(); ++k)
             {
@@ -342,23 +327,6 @@ namespace PeriDEAL
                                                  e - b, c) :
                         row_value(i);
         }
-  }
-
-  template <int dim>
-  void
-  DiffusionOperator<dim>::apply_row_range(const Vector      &C,
-                                          Vector            &rate,
-                                          const unsigned int begin,
-                                          const unsigned int end) const
-  {
-    AssertThrow(!corrosion && !wls, ExcMessage("apply_row_range: linear diffusion without WLS rows only"));
-    AssertIndexRange(end, disc.n_owned() + 1);
-    const auto   &nb = disc.neighborhood;
-    const double *c  = C.begin();
-    double       *r  = rate.begin();
-    for (unsigned int i = begin; i < end; ++i)
-      r[i] = linear_row(nb.col.data(), nb.row_start.data(), nb.table_start.data(),
-                        geometric_weight.data(), row_sum.data(), kappa_table[0], c, i);
   }
 
   template <int dim>

@@ -1111,59 +1111,6 @@ namespace
   }
 
   /**
-   * The absorbing sums overlapped with the operator sweep (the default, here
-   * in blocks of 31 rows so that a small disc has many blocks) give bitwise
-   * the same run as the sequential update before the step, for the EBF and
-   * the first-order ABC, also (EBF) when the state is reset by the one-step
-   * map (one_step_spectral_radius()) in between.
-   */
-  void
-  overlap()
-  {
-    const auto all = [](const Point<2> &) { return true; };
-    for (const WaveTruncation boundary : {WaveTruncation::absorbing, WaveTruncation::first_order})
-      {
-        const std::string name = boundary == WaveTruncation::absorbing ? "EBF" : "first order";
-        WaveAbcParameters prm;
-        prm.cone_angle = 0.5;
-        PdUnboundedWave<2> seq(MPI_COMM_SELF), ovl(MPI_COMM_SELF), map(MPI_COMM_SELF);
-        setup_e14_disc(seq, 3., boundary, prm);
-        setup_e14_disc(ovl, 3., boundary, prm);
-        setup_e14_disc(map, 3., boundary, prm);
-        seq.set_abc_overlap(false);
-        ovl.set_abc_overlap(true, 31);
-        map.set_abc_overlap(true, 31);
-        double rho = 0.;
-        for (unsigned int n = 0; n < 400; ++n)
-          {
-            if (n == 150 && boundary == WaveTruncation::absorbing)
-              rho = map.one_step_spectral_radius(3000);
-            for (PdUnboundedWave<2> *pd : {&seq, &ovl, &map})
-              pd->advance();
-          }
-        const auto &us = seq.displacement(), &uo = ovl.displacement(), &um = map.displacement();
-        unsigned int n_differ = 0;
-        double       u_max    = 0.;
-        for (unsigned int i = 0; i < us.locally_owned_size(); ++i)
-          {
-            n_differ += us.local_element(i) != uo.local_element(i) || us.local_element(i) != um.local_element(i);
-            u_max = std::max(u_max, std::abs(us.local_element(i)));
-          }
-        check(u_max > 1e-3 && ovl.absorbing_boundary().absorbing_points().size() > 0 &&
-                us.locally_owned_size() / 31 >= 10 && n_differ == 0,
-              name + ": overlapped sums (" + std::to_string(us.locally_owned_size() / 31) +
-                " blocks) and sequential update give the same u bitwise after 400 steps (" +
-                std::to_string(n_differ) + " of " + std::to_string(us.locally_owned_size()) +
-                " nodes differ, max |u| " + sci(u_max) + ")");
-        check(seq.energy(all) == ovl.energy(all) && seq.energy(all) == map.energy(all) &&
-                seq.half_step_energy() == ovl.half_step_energy() &&
-                (rho > 0. || boundary != WaveTruncation::absorbing),
-              name + ": the same energies bitwise (" + sci(seq.energy(all)) + "), also across the one-step map (radius " +
-                sci(rho) + ")");
-      }
-  }
-
-  /**
    * Largest increase of the half-step energy E^{n+1/2} (scaled by its first
    * value) over @p n_steps steps of the E14 pulse on a disc of radius @p R;
    * the first and last values go to @p e_first, @p e_last, the largest
@@ -1403,7 +1350,6 @@ main(int argc, char **argv)
               {"pd_1d_modes", pd_1d_modes},
               {"pd_2d", pd_2d},
               {"pd_2d_ranks", pd_2d_ranks},
-              {"overlap", overlap},
               {"fem_2d", fem_2d},
               {"spectral_radius", spectral_radius},
               {"semi_discrete", [] { semi_discrete(false); }},

@@ -16,7 +16,6 @@
 #include <perideal/models/diffusion.h>
 #include <perideal/models/scalar_wave.h>
 
-#include <algorithm>
 #include <array>
 #include <complex>
 #include <tuple>
@@ -311,23 +310,6 @@ namespace PeriDEAL
               std::vector<double> &u_new,
               std::vector<double> &v_new) const;
 
-      /**
-       * compute() for the absorbing points begin <= a < end only (u_new and
-       * v_new hold absorbing_points().size() values): the same values. The u
-       * and the v sums are independent, so their data may be of different
-       * steps (PdUnboundedWave sums the u half of the next step and the v half
-       * of the current one while it sweeps the operator's rows).
-       */
-      void
-      compute(const unsigned int begin,
-              const unsigned int end,
-              const double      *u,
-              const double      *u_old,
-              const double      *v,
-              const double      *v_old,
-              double            *u_new,
-              double            *v_new) const;
-
       /** Only u_new[a] = V_G . (u^n_j, u^{n-1}_j)_j (callers that derive v otherwise). */
       void
       compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const;
@@ -495,30 +477,8 @@ namespace PeriDEAL
       {
         return *relation;
       }
-      /**
-       * Wall seconds in the ABC update and in the whole of advance(). With the
-       * overlapped update (set_abc_overlap()) abc_seconds holds only the parts
-       * outside the operator sweep (the copies of the cloud values and the
-       * overwrites); the whole ABC cost is then the step time against the free
-       * truncation of the same near field (contrib/benchmarks/abc_benchmark.cc).
-       */
+      /** Wall seconds in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
-      /**
-       * true (default): the dot products of the absorbing update are summed
-       * in blocks between blocks of the operator's row sweep, the u half for
-       * the next step (u^{n+1} is final before the sweep) and the v half for
-       * the current one (from a copy of v^n), so that their coefficient
-       * stream overlaps the row loop instead of following it cold. false: all
-       * of them before the step as in (4.82). Bitwise the same results.
-       * @p rows_per_block: rows of the sweep per block of absorbing sums.
-       */
-      void
-      set_abc_overlap(const bool on, const unsigned int rows_per_block = 1024)
-      {
-        overlap_abc     = on;
-        abc_block_rows  = std::max(1u, rows_per_block);
-        abc_ready       = false;
-      }
       /**
        * Benchmarks only: @p on makes advance() skip all absorbing work (the
        * near field then steps as the free truncation), to time the step
@@ -528,8 +488,7 @@ namespace PeriDEAL
       void
       set_abc_skipped(const bool on)
       {
-        skip_abc  = on;
-        abc_ready = false;
+        skip_abc = on;
       }
       /** One-step spectral radius computed by setup (0 if not checked). */
       double spectral_radius = 0.;
@@ -557,24 +516,12 @@ namespace PeriDEAL
       /** Lu = L u (u with current ghosts), minus the broken bonds. */
       void
       apply_operator();
-      /**
-       * apply_operator() with the absorbing sums interleaved (set_abc_overlap()):
-       * u_next from u^{n+1}, u^n = u_old, v_abc from v^n = v_now, v^{n-1} = v_old.
-       */
-      void
-      apply_operator_with_abc();
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       std::unique_ptr<WaveDispersion<dim>>    relation;
       EbfWaveAbc<dim>                         abc;
       Vector                                  u, v, a, Lu;
       std::vector<double>                     u_old, v_old, u_abc, v_abc;
-      /** Overlapped update: v^n at the cloud points and u^{n+2} of the absorbing nodes. */
-      std::vector<double>                     v_now, u_next;
-      /** Overlapped update: on, and u_abc already summed by the last sweep. */
-      bool                                    overlap_abc = true, abc_ready = false, skip_abc = false;
-      unsigned int                            abc_block_rows = 1024;
-
       std::vector<double>                     bond_kernel_weight;
       /** d + sigma(x_i) per owned node; v^{n-1/2} and u^{n-1} of the last step. */
       std::vector<double>                     damping, v_half, u_prev;
@@ -583,7 +530,7 @@ namespace PeriDEAL
       /** PML (method "pml"): the band, its weights and memories. */
       PmlBand<dim>                            pml_band;
       double                                  dt = 0., t = 0., d = 0.;
-      bool                                    absorbing = false;
+      bool                                    absorbing = false, skip_abc = false;
     };
   } // namespace Abc
 } // namespace PeriDEAL

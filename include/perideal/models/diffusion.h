@@ -175,17 +175,6 @@ namespace PeriDEAL
     apply(const Vector &C, Vector &rate, const Vector *phase, const Rows rows) const;
 
     /**
-     * Linear diffusion without WLS rows only: rate_i = (L C)_i for the owned
-     * rows begin <= i < end, bitwise the same values as apply(). A caller can
-     * sweep the rows in blocks and interleave other work with the sweep
-     * (PdUnboundedWave: the absorbing update, whose coefficient stream then
-     * overlaps the operator's row loop).
-     */
-    void
-    apply_row_range(const Vector &C, Vector &rate, const unsigned int begin,
-                    const unsigned int end) const;
-
-    /**
      * Largest forward Euler step the Gershgorin theorem proves stable for
      * this boundary treatment: min_i 2 / (|l_ii| + R_i) over the rows of the
      * unknowns, R_i the sum of the couplings to other unknowns (nodes of the
