@@ -977,10 +977,12 @@ namespace PeriDEAL
     {
       using clock        = std::chrono::steady_clock;
       const auto   start = clock::now();
-      const auto  &nodes = abc.absorbing_points();
-      const double half  = 0.5 * dt;
+      static const std::vector<unsigned int> none;
+      const bool                             use_abc = absorbing && !skip_abc;
+      const std::vector<unsigned int>       &nodes   = use_abc ? abc.absorbing_points() : none;
+      const double                           half    = 0.5 * dt;
       // (4.82) from the levels n and n-1 (ghosts of u, v are current).
-      if (absorbing)
+      if (use_abc)
         {
           abc.compute(u.begin(), u_old.data(), v.begin(), v_old.data(), u_abc, v_abc);
           for (const unsigned int j : abc.cloud_points())
@@ -1018,7 +1020,7 @@ namespace PeriDEAL
       const auto set_start = clock::now();
       for (unsigned int c = 0; c < nodes.size(); ++c)
         vv[nodes[c]] = v_abc[c];
-      if (absorbing)
+      if (use_abc)
         v.update_ghost_values();
       const auto end = clock::now();
       abc_seconds += std::chrono::duration<double>(abc_end - start + end - set_start).count();

@@ -479,6 +479,17 @@ namespace PeriDEAL
       }
       /** Wall seconds in the ABC update and in the whole of advance(). */
       double abc_seconds = 0., step_seconds = 0.;
+      /**
+       * Benchmarks only: @p on makes advance() skip all absorbing work (the
+       * near field then steps as the free truncation), to time the step
+       * without the ABC on the same objects and memory as with it
+       * (contrib/benchmarks/abc_benchmark.cc).
+       */
+      void
+      set_abc_skipped(const bool on)
+      {
+        skip_abc = on;
+      }
       /** One-step spectral radius computed by setup (0 if not checked). */
       double spectral_radius = 0.;
       /** Total damping rate d + sigma(x_i) of each owned node (the sponge). */
@@ -519,7 +530,7 @@ namespace PeriDEAL
       /** PML (method "pml"): the band, its weights and memories. */
       PmlBand<dim>                            pml_band;
       double                                  dt = 0., t = 0., d = 0.;
-      bool                                    absorbing = false;
+      bool                                    absorbing = false, skip_abc = false;
     };
   } // namespace Abc
 } // namespace PeriDEAL
