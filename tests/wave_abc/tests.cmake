@@ -1,6 +1,6 @@
 perideal_add_test_program(wave_abc_tests ${CMAKE_CURRENT_LIST_DIR}/wave_abc_tests.cc)
 
-foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml)
+foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS unit)
 endforeach()
 foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)

@@ -483,7 +483,8 @@ namespace PeriDEAL
        * Benchmarks only: @p on makes advance() skip all absorbing work (the
        * near field then steps as the free truncation), to time the step
        * without the ABC on the same objects and memory as with it
-       * (contrib/benchmarks/abc_benchmark.cc).
+       * (contrib/benchmarks/abc_benchmark.cc). Switching it off again resumes
+       * the ABC from the stale level n-1 of before the skip: timing only.
        */
       void
       set_abc_skipped(const bool on)
