@@ -89,6 +89,10 @@ namespace PeriDEAL
       prm.declare_entry("Layer filter", "0", Patterns::Double(0., 0.25),
                         "eps of the lattice-Laplacian viscosity added to the updating vectors "
                         "(eps sum over the nearest nodes of (u_j - u_i)^n - (u_j - u_i)^{n-1}; 0: the source).");
+      prm.declare_entry("Fit form", "value", Patterns::Selection("value|increment"),
+                        "value (the source: V = Psi(0, dt) M^+) or increment (V = e_i + "
+                        "(Psi(0, dt) - Psi(0, 0)) M^+: a truncated pseudo-inverse filters only the "
+                        "change over one step).");
       prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge|pml"),
                         "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), "
                         "only the damping sponge (PD: nothing overwritten, energy-stable), or the "
@@ -134,6 +138,7 @@ namespace PeriDEAL
       lattice_modes            = prm.get("Lattice modes");
       lattice_mode_damping     = prm.get_double("Lattice mode damping");
       layer_filter             = prm.get_double("Layer filter");
+      fit_form                 = prm.get("Fit form");
       method                   = prm.get("Method");
       sponge_damping           = prm.get_double("Sponge damping");
       sponge_thickness         = prm.get_double("Sponge thickness");
@@ -538,6 +543,9 @@ namespace PeriDEAL
           // weights (one with weight 1, or a block average, see below).
           std::vector<std::vector<std::pair<unsigned int, double>>> members;
           const bool average = prm.thinning == "average";
+          check_parameter(prm.fit_form == "value" || prm.fit_form == "increment", "Absorbing boundary/Fit form",
+                          prm.fit_form, "value or increment");
+          const bool increment = prm.fit_form == "increment";
           for (; stride <= 8 && !ok; ++stride)
             {
               // Auxiliary grid of spacing stride * dx in the local frame
@@ -621,6 +629,11 @@ namespace PeriDEAL
                 {
                   psi_g[c] = mode(Tensor<1, dim>(), dt, c);
                   psi_h[c] = mode_rate(c) * psi_g[c];
+                  if (increment)
+                    {
+                      psi_g[c] -= mode(Tensor<1, dim>(), 0., c);
+                      psi_h[c] -= mode_rate(c) * mode(Tensor<1, dim>(), 0., c);
+                    }
                   for (unsigned int j = 0; j < cloud.size(); ++j)
                     for (unsigned int s = 0; s < 2; ++s)
                       {
@@ -636,6 +649,14 @@ namespace PeriDEAL
                 }
               fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance);
               fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance);
+              if (increment)
+                {
+                  // + e_i: cloud[0] = x_i, row 0 = level n.
+                  fg.V[0] += 1.;
+                  fh.V[0] += 1.;
+                  fg.vmax = fg.V.cwiseAbs().maxCoeff();
+                  fh.vmax = fh.V.cwiseAbs().maxCoeff();
+                }
               ok = fg.cond <= prm.max_condition_number && fh.cond <= prm.max_condition_number &&
                    fg.vmax <= prm.max_update_norm && fh.vmax <= prm.max_update_norm;
             }

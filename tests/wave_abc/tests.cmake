@@ -7,8 +7,9 @@ foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS convergence)
 endforeach()
 # E12c at the source's size (150,000 steps) and the EBF part of the
-# semi-discrete analysis (two dense 2D eigenproblems); the sponge over 1e6 steps.
-foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long)
+# semi-discrete analysis (two dense 2D eigenproblems); the sponge over 1e6 steps;
+# E15 at the source's radii (26, 42; ~270k nodes in all).
+foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
 perideal_add_test(NAME wave_abc.pd_2d_ranks.np2 NPROCS 2

@@ -106,6 +106,16 @@ namespace PeriDEAL
        */
       double layer_filter = 0.;
       /**
+       * "value" (the source: V_G = Psi(0, dt) M_G^+, V_H likewise) or
+       * "increment": the fit extrapolates the change over one step,
+       * V_G = e_i + (Psi(0, dt) - Psi(0, 0)) M_G^+ (e_i: the level-n entry
+       * of x_i; V_H likewise). Identical when M^+ reproduces Psi(0, 0)
+       * (x_i is in its cloud and no singular value is cut); with a
+       * truncated pseudo-inverse only the increment is filtered, so that
+       * V -> e_i as dt -> 0 (doc/design.md, session 11).
+       */
+      std::string fit_form = "value";
+      /**
        * "ebf" (the EBF extrapolation (4.82)) or "first order": the
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone
