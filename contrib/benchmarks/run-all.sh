@@ -23,7 +23,7 @@
 #               missing)
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
-#   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 10)
+#   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 100)
 #   KW_ARGS     options of kw_multiadaptive_benchmark (default: its CI-size case)
 #   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.25 --m 8",
 #               the source's lattice of Table 3.3;
@@ -337,8 +337,8 @@ fi
 "$fem_abc_exe" "${ABC_STEPS:-2000}" | grep '^abc_overhead_fraction_' | tee -a "$results"
 
 # 3D corrosion: hybrid vs standard, multi-grid / adaptive hybrid vs uniform
-# fine (serial; CORROSION_STEPS timed steps, default 10).
-"$corrosion_exe" --steps "${CORROSION_STEPS:-10}" | grep -v '^#' | tee -a "$results"
+# fine (serial; CORROSION_STEPS timed steps, default 100).
+"$corrosion_exe" --steps "${CORROSION_STEPS:-100}" | grep -v '^#' | tee -a "$results"
 # Multi-adaptive Kalthoff-Winkler (serial): Table 1 of paper 001 at
 # KW_ARGS (default dx+ = 2 dx- = 1 mm, delta = 4 mm).
 kw_exe="$build/contrib/benchmarks/kw_multiadaptive_benchmark"

@@ -1,6 +1,8 @@
 #include <perideal/base/exceptions.h>
 #include <perideal/time_stepping/velocity_verlet.h>
 
+#include <cmath>
+
 #include <sstream>
 #include <type_traits>
 
@@ -355,41 +357,7 @@ namespace PeriDEAL
   void
   VelocityVerlet<dim>::advance()
   {
-    sync_node_vectors();
-    const unsigned int n = disc.n_owned();
-    // Held nodes: u^{n+1} from the prescribed function, v = du/dt by the
-    // difference quotient (set first: it needs u^n); velocity sets drift
-    // with the midpoint velocity.
-    apply_prescribed_displacements(t + dt, true);
-    if (!prescribed_values.empty())
-      apply_prescribed_velocities(t + 0.5 * dt);
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        double       *u = displacement[d].begin();
-        double       *v = velocity[d].begin();
-        const double *a = acceleration[d].begin();
-        for (unsigned int i = 0; i < n; ++i)
-          {
-            v[i] += 0.5 * dt * a[i];
-            u[i] += dt * v[i];
-          }
-      }
-    apply_prescribed_displacements(t + dt, false);
-    if (!prescribed_values.empty())
-      apply_prescribed_velocities(t + dt);
-    if (body_force_function)
-      body_force_function(t + dt, body_force);
-    update_accelerations();
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        double       *v = velocity[d].begin();
-        const double *a = acceleration[d].begin();
-        for (unsigned int i = 0; i < n; ++i)
-          v[i] += 0.5 * dt * a[i];
-      }
-    // Prescribed nodes have a = 0, so their velocity stays as set.
-    t += dt;
-    ++n_steps;
+    advance(1);
   }
 
   template <int dim>
@@ -397,10 +365,99 @@ namespace PeriDEAL
   VelocityVerlet<dim>::advance(const unsigned int n)
   {
     if (n > 1 && uses_box_state())
-      advance_in_box(n);
-    else
-      for (unsigned int s = 0; s < n; ++s)
-        advance();
+      {
+        advance_in_box(n);
+        return;
+      }
+    // What does not change within the call is read once, not per step:
+    // the held nodes, the velocity-held nodes (both increasing) and whether
+    // b is +0 everywhere without a body force function (a -0 would change
+    // the sign of a zero force sum).
+    sync_node_vectors();
+    const unsigned int        n_owned = disc.n_owned();
+    std::vector<unsigned int> held, velocity_held;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      {
+        if (is_held(i))
+          held.push_back(i);
+        if (prescribed_set[i] >= 0)
+          velocity_held.push_back(i);
+      }
+    bool zero_body = !body_force_function;
+    for (unsigned int d = 0; d < dim && zero_body; ++d)
+      for (unsigned int i = 0; i < n_owned; ++i)
+        {
+          const double b = body_force[d].local_element(i);
+          zero_body      = zero_body && b == 0. && !std::signbit(b);
+        }
+    std::vector<double> held_velocity(held.size());
+    const auto          set_velocities = [&](const double time) {
+      for (const unsigned int i : velocity_held)
+        {
+          const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time);
+          for (unsigned int d = 0; d < dim; ++d)
+            velocity[d].local_element(i) = v[d];
+        }
+    };
+    const double inv_rho = 1. / rho;
+    for (unsigned int s = 0; s < n; ++s)
+      {
+        sync_node_vectors();
+        // Held nodes: u^{n+1} from the prescribed function, v = du/dt by
+        // the difference quotient (set first: it needs u^n); velocity sets
+        // drift with the midpoint velocity.
+        apply_prescribed_displacements(t + dt, true);
+        set_velocities(t + 0.5 * dt);
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            double       *u = displacement[d].begin();
+            double       *v = velocity[d].begin();
+            const double *a = acceleration[d].begin();
+            for (unsigned int i = 0; i < n_owned; ++i)
+              {
+                v[i] += 0.5 * dt * a[i];
+                u[i] += dt * v[i];
+              }
+          }
+        apply_prescribed_displacements(t + dt, false);
+        set_velocities(t + dt);
+        if (body_force_function)
+          body_force_function(t + dt, body_force);
+        for (auto &u : displacement)
+          u.update_ghost_values();
+        model.compute_forces(displacement, force);
+        // a = (f + b) / rho (update_accelerations()) and the second
+        // half-kick in one pass. Held nodes have a = 0: their v gets
+        // v + 0.5 dt 0 as in the separate passes (also for v = -0).
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            double       *v = velocity[d].begin();
+            double       *a = acceleration[d].begin();
+            const double *f = force[d].begin();
+            const double *b = body_force[d].begin();
+            for (std::size_t k = 0; k < held.size(); ++k)
+              held_velocity[k] = v[held[k]];
+            if (zero_body)
+              for (unsigned int i = 0; i < n_owned; ++i)
+                {
+                  a[i] = inv_rho * (f[i] + 0.);
+                  v[i] += 0.5 * dt * a[i];
+                }
+            else
+              for (unsigned int i = 0; i < n_owned; ++i)
+                {
+                  a[i] = inv_rho * (f[i] + b[i]);
+                  v[i] += 0.5 * dt * a[i];
+                }
+            for (std::size_t k = 0; k < held.size(); ++k)
+              {
+                a[held[k]] = 0.;
+                v[held[k]] = held_velocity[k] + 0.5 * dt * 0.;
+              }
+          }
+        t += dt;
+        ++n_steps;
+      }
   }
 
   template <int dim>
