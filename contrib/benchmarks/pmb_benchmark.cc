@@ -34,6 +34,9 @@
 //                    out of the sweep's box layout each (the default defers
 //                    the node vectors to one sync_node_vectors() at the end
 //                    of the timed loop, which is timed)
+//   --no-sweep-pairs  3D sweep without paired passes (one reaction store
+//                    per bond vector; for A/B runs, see
+//                    BondBasedOperator::set_lattice_sweep_pairs())
 //   --profile-steps S  only run S Verlet steps after setup (for profilers)
 //   --trace-steps S  only run S single Verlet steps, printing each one's CPU
 //                    time and the broken-bond fraction after it
@@ -89,6 +92,7 @@ namespace
     unsigned int      repeats       = 1;
     bool              loop_only     = false;
     bool              sync_every_call = false;
+    bool              no_sweep_pairs  = false;
     unsigned int      profile_steps = 0;
     unsigned int      trace_steps   = 0;
     std::vector<unsigned int> chunks;
@@ -182,6 +186,7 @@ namespace
     const auto                              fresh_state = [&] {
       verlet_ptr.reset();
       model_ptr = std::make_unique<BondBasedOperator<dim>>(*disc, mp);
+      model_ptr->set_lattice_sweep_pairs(!opt.no_sweep_pairs);
       dt        = 0.5 * model_ptr->critical_time_step(rho);
       v0        = 4. * model_ptr->critical_stretch();
       verlet_ptr = std::make_unique<VelocityVerlet<dim>>(*model_ptr, rho, dt);
@@ -637,6 +642,8 @@ namespace
                            opt.loop_only = true;
                          else if (arg == "--sync-every-call")
                            opt.sync_every_call = true;
+                         else if (arg == "--no-sweep-pairs")
+                           opt.no_sweep_pairs = true;
                          else if (arg == "--trace-steps")
                            opt.trace_steps = std::stoi(next());
                          else if (arg == "--agreement")

@@ -319,15 +319,79 @@ namespace PeriDEAL
 
   template <int dim>
   void
+  BondBasedOperator<dim>::set_lattice_sweep_pairs(const bool use_pairs)
+  {
+    sweep_pairs = use_pairs;
+    set_sweep_bit_slots();
+  }
+
+  template <int dim>
+  void
   BondBasedOperator<dim>::set_sweep_bit_slots()
   {
-    // The K offsets h, h + G, ... of a pass get adjacent slots K h, ...,
-    // K h + K - 1 (G = H / K), the remainder its own index; the byte row of
-    // a group has H slots rounded up to a multiple of 8.
-    const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
-    std::vector<unsigned int> slot(H);
+    const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass;
+    sweep_pass.clear();
+    sweep_pass_offset.clear();
+    sweep_pair_delta = 0;
+    // Paired passes (3D, four pairs per pass): offsets o and o + D, D the
+    // smallest of 1, 2, 4 box rows that is a whole number of groups of
+    // eight positions (sweep_offset is increasing).
+    std::vector<unsigned int> first, second, single;
+    if (dim == 3 && K == 4 && sweep_pairs)
+      for (const std::int64_t m : {1, 2, 4})
+        if (m * sweep_stride[1 % dim] % 8 == 0)
+          {
+            sweep_pair_delta = m * sweep_stride[1 % dim];
+            break;
+          }
+    std::vector<bool> paired(H, false);
+    if (sweep_pair_delta > 0)
+      for (unsigned int h = 0; h < H; ++h)
+        if (!paired[h])
+          {
+            const auto it = std::lower_bound(sweep_offset.begin(), sweep_offset.end(),
+                                             sweep_offset[h] + sweep_pair_delta);
+            const unsigned int h2 = it - sweep_offset.begin();
+            if (it != sweep_offset.end() && *it == sweep_offset[h] + sweep_pair_delta && !paired[h2])
+              {
+                first.push_back(h);
+                second.push_back(h2);
+                paired[h] = paired[h2] = true;
+              }
+          }
     for (unsigned int h = 0; h < H; ++h)
-      slot[h] = h < K * G ? K * (h % G) + h / G : h;
+      if (!paired[h])
+        single.push_back(h);
+    // A pass takes the pairs (or offsets) q, q + G, q + 2G, ... of its list
+    // (G = its length / K rounded up for pairs, down for single offsets),
+    // which lie in different lattice lines: the reactions of one pass are
+    // more than 8 apart, so no store partially overlaps the next load.
+    const unsigned int P = first.size(), GP = (P + K - 1) / K;
+    for (unsigned int g = 0; g < GP; ++g)
+      {
+        const unsigned int start = sweep_pass_offset.size();
+        for (const auto *list : {&first, &second})
+          for (unsigned int q = g; q < P; q += GP)
+            sweep_pass_offset.push_back((*list)[q]);
+        sweep_pass.push_back({{start, (unsigned int)(sweep_pass_offset.size() - start) / 2, 1}});
+      }
+    const unsigned int S = single.size(), G = S / K;
+    for (unsigned int g = 0; g < G; ++g)
+      {
+        sweep_pass.push_back({{(unsigned int)sweep_pass_offset.size(), K, 0}});
+        for (unsigned int q = 0; q < K; ++q)
+          sweep_pass_offset.push_back(single[g + q * G]);
+      }
+    for (unsigned int q = K * G; q < S; ++q)
+      {
+        sweep_pass.push_back({{(unsigned int)sweep_pass_offset.size(), 1, 0}});
+        sweep_pass_offset.push_back(single[q]);
+      }
+    // The offsets of a pass get adjacent bit slots, in pass order; the byte
+    // row of a group has H slots rounded up to a multiple of 8.
+    std::vector<unsigned int> slot(H);
+    for (unsigned int i = 0; i < sweep_pass_offset.size(); ++i)
+      slot[sweep_pass_offset[i]] = i;
     if (slot != sweep_bit_slot)
       {
         sweep_bit_slot   = slot;
@@ -445,6 +509,36 @@ namespace PeriDEAL
             table_checked.assign(1, true);
           }
       }
+
+    // Keep only the offsets that occur in a row: the half of the stencil's
+    // bounding box also holds offsets beyond the horizon (3D m = 3 with
+    // partial volumes: 364, of which 89 are bonds), and a pass over those
+    // would only read zero bits (and dilute the passes of live offsets).
+    {
+      std::vector<int> live_index(n_half, -1);
+      unsigned int     n_live = 0;
+      for (unsigned int h = 0; h < n_half; ++h)
+        if (seen[h])
+          {
+            live_index[h] = n_live;
+            sweep_offset[n_live]    = sweep_offset[h];
+            sweep_box_index[n_live] = sweep_box_index[h];
+            sweep_slot[n_live]      = sweep_slot[h];
+            sweep_k[n_live]         = sweep_k[h];
+            sweep_r[n_live]         = sweep_r[h];
+            ++n_live;
+          }
+      if (n_live == 0)
+        return;
+      sweep_offset.resize(n_live);
+      sweep_box_index.resize(n_live);
+      sweep_slot.resize(n_live);
+      sweep_k.resize(n_live);
+      sweep_r.resize(n_live);
+      for (int &h : sweep_half_of_box)
+        if (h >= 0)
+          h = live_index[h];
+    }
 
     // Offsets per pass: in 3D four (1.04-1.11x two in interleaved CPU-time
     // runs of 3D m = 3, doc/benchmarks.md); in 2D two (four measured the
@@ -986,35 +1080,51 @@ namespace PeriDEAL
       {
         const unsigned int n = std::min<std::size_t>(C, n_bits - c0);
         std::fill(a, a + dim * C, 0.);
-        // K offsets per pass (shared p_L loads and force updates): h,
-        // h + G, h + 2G, ... (G = H / K), which lie in different lattice
-        // lines; the remainder one at a time.
-        const unsigned int H = sweep_offset.size(), K = sweep_offsets_per_pass, G = H / K;
-        const auto pass = [&](auto no, const unsigned int *hs) {
+        // The passes of set_sweep_bit_slots(): K offsets each (shared p_L
+        // loads and force updates), or K pairs (also shared reactions).
+        const internal::LatticeSweep::LiveBits bits{
+          sweep_live.data(), 1, sweep_bit_row, sweep_bit_slot.data()};
+        const auto plain = [&](auto no, const unsigned int *hs, const std::size_t first,
+                               const unsigned int n_groups) {
           internal::LatticeSweep::sweep_offsets<dim, decltype(no)::value>(
-            p, R, a, {sweep_live.data(), 1, sweep_bit_row, sweep_bit_slot.data()}, N, C, c0,
-            nullptr, n / 8, sweep_offset.data(), hs, sweep_k.data(), sweep_r.data(), s0, sweep_broken);
+            p, R, a + (first - c0), bits, N, C, first, nullptr, n_groups, sweep_offset.data(), hs,
+            sweep_k.data(), sweep_r.data(), s0, sweep_broken);
         };
-        for (unsigned int h = 0; h < G; ++h)
+        const auto pass = [&](auto no, const unsigned int *hs, const bool paired) {
+          const unsigned int n_groups = n / 8;
+          if (!paired)
+            {
+              plain(no, hs, c0, n_groups);
+              return;
+            }
+          // First offsets from the groups below D / 8 alone, then both, then
+          // the second offsets from the last D / 8 groups alone.
+          const unsigned int dg = sweep_pair_delta / 8, edge = std::min(dg, n_groups);
+          plain(no, hs, c0, edge);
+          if (dg < n_groups)
+            internal::LatticeSweep::sweep_offset_pairs<dim, decltype(no)::value>(
+              p, R, a, bits, N, C, c0, dg, n_groups, sweep_offset.data(), hs, sweep_pair_delta,
+              sweep_k.data(), sweep_r.data(), s0, sweep_broken);
+          plain(no, hs + decltype(no)::value, c0 + 8 * (n_groups - edge), edge);
+        };
+        for (const auto &[first, K, paired] : sweep_pass)
           {
-            const unsigned int hs[4] = {h, h + G, h + 2 * G, h + 3 * G};
+            const unsigned int *hs = sweep_pass_offset.data() + first;
             switch (K)
               {
                 case 1:
-                  pass(std::integral_constant<int, 1>(), hs);
+                  pass(std::integral_constant<int, 1>(), hs, paired);
                   break;
                 case 2:
-                  pass(std::integral_constant<int, 2>(), hs);
+                  pass(std::integral_constant<int, 2>(), hs, paired);
                   break;
                 case 3:
-                  pass(std::integral_constant<int, 3>(), hs);
+                  pass(std::integral_constant<int, 3>(), hs, paired);
                   break;
                 default:
-                  pass(std::integral_constant<int, 4>(), hs);
+                  pass(std::integral_constant<int, 4>(), hs, paired);
               }
           }
-        for (unsigned int h = K * G; h < H; ++h)
-          pass(std::integral_constant<int, 1>(), &h);
         for (unsigned int d = 0; d < dim; ++d)
           {
             double *__restrict ad = a + d * C, *__restrict Rd = R + d * N + c0;

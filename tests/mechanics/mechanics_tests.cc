@@ -635,15 +635,23 @@ namespace
   // force_kernel_dim().
   template <int dim>
   void
-  half_list_dim(const Loop loop = Loop::half_list)
+  half_list_dim(const Loop loop = Loop::half_list, const double length = dim == 3 ? 1. : 2.)
   {
     force_kernel_dim<dim>(loop);
-    const auto               disc = make_box<dim>(MPI_COMM_WORLD, dim == 3 ? 1. : 2., 0.1, 0.3015);
+    const auto               disc = make_box<dim>(MPI_COMM_WORLD, length, 0.1, 0.3015);
     BondBasedModelParameters p;
     p.critical_stretch = 0.01;
     BondBasedOperator<dim> half(*disc, p), full(*disc, p);
     select_loop(half, loop);
     select_loop(full, Loop::full_list);
+    // 3D sweeps of 16 nodes per row (box rows of a multiple of 8 positions)
+    // run the paired passes (set_lattice_sweep_pairs()).
+    if (loop == Loop::lattice_sweep && dim == 3 && length == 1.5 &&
+        Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1 &&
+        BondBasedOperator<dim>::lattice_sweep_compiled())
+      check(half.n_lattice_sweep_pairs() > 0,
+            "3D sweep, 16 nodes per row: " + std::to_string(half.n_lattice_sweep_pairs()) +
+              " offset pairs");
     // Pre-crack-like random cuts: a symmetric predicate of the end points.
     const auto cuts = [](const Point<dim> &a, const Point<dim> &b) {
       double h = 0.;
@@ -727,12 +735,14 @@ namespace
   // positions, Newton's third law, broken flags as bits): the checks of
   // half_list() (direct evaluation of (3.1); forces, broken flags of both
   // copies and damage against the full list over two calls with pre-cut
-  // and newly breaking bonds; momentum), on 1 and 2 ranks.
+  // and newly breaking bonds; momentum), on 1 and 2 ranks; in 3D also on a
+  // box of 16 nodes per row, where the sweep runs its paired passes.
   void
   lattice_sweep()
   {
     half_list_dim<2>(Loop::lattice_sweep);
     half_list_dim<3>(Loop::lattice_sweep);
+    half_list_dim<3>(Loop::lattice_sweep, 1.5);
   }
 
   // VelocityVerlet::advance(n) keeps the state in the lattice sweep's box

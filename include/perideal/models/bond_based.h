@@ -243,6 +243,26 @@ namespace PeriDEAL
      */
     void
     set_lattice_sweep_offsets_per_pass(const unsigned int k);
+    /**
+     * In 3D with four offsets per pass: evaluate the offsets o and o + D
+     * (D the smallest of 1, 2 or 4 box rows that is a multiple of 8
+     * positions) as pairs, the first from the positions L, the second from
+     * L - D, so that both reactions land on L + o and are stored once
+     * (default true; sweep_offset_pairs() in lattice_sweep_kernel.h). A
+     * tuning knob like set_lattice_sweep_offsets_per_pass(): the forces
+     * change by round-off (summation order), the broken bonds do not.
+     */
+    void
+    set_lattice_sweep_pairs(const bool use_pairs);
+    /** Offset pairs the sweep evaluates in paired passes (0: none). */
+    unsigned int
+    n_lattice_sweep_pairs() const
+    {
+      unsigned int n = 0;
+      for (const auto &pass : sweep_pass)
+        n += pass[2] ? pass[1] : 0;
+      return n;
+    }
     /** Largest chunk of set_lattice_sweep_chunk(). */
     static constexpr unsigned int max_sweep_chunk = 2048;
     /** True if the library was compiled with the AVX-512 sweep kernel. */
@@ -426,6 +446,17 @@ namespace PeriDEAL
     unsigned int sweep_chunk = 512;
     /** Offsets per pass of the sweep (set_lattice_sweep_offsets_per_pass()). */
     unsigned int sweep_offsets_per_pass = 2;
+    /** Paired passes selected (set_lattice_sweep_pairs()). */
+    bool sweep_pairs = true;
+    /**
+     * The sweep's passes in order: {first entry of sweep_pass_offset, n,
+     * paired}; a plain pass evaluates the n offsets sweep_pass_offset[first
+     * ...] (sweep_offsets()), a paired one the n pairs (first + q, first +
+     * n + q) whose offsets differ by sweep_pair_delta (sweep_offset_pairs()).
+     */
+    std::vector<std::array<unsigned int, 3>> sweep_pass;
+    std::vector<unsigned int>                sweep_pass_offset;
+    std::int64_t                             sweep_pair_delta = 0;
     /** Lattice sweep selected (set_lattice_sweep()) and possible. */
     bool sweep = true, sweep_available = false;
     /** The sweep's live bits are in sync with broken_flag. */
@@ -459,7 +490,10 @@ namespace PeriDEAL
     std::vector<std::uint8_t> sweep_live;
     std::vector<unsigned int> sweep_bit_slot;
     std::size_t               sweep_bit_row = 0;
-    /** Bit slots of the offsets for the current offsets per pass (invalidates the bits). */
+    /**
+     * The passes of the sweep (sweep_pass) and the bit slots of the offsets
+     * for the current offsets per pass and pairing (invalidates the bits).
+     */
     void
     set_sweep_bit_slots();
     /**

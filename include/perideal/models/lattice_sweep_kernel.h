@@ -289,6 +289,160 @@ namespace PeriDEAL
           for (unsigned int g = 0; g < n_groups; ++g)
             group(8 * g);
       }
+
+      /**
+       * The body of a paired pass of a lattice sweep: the NO offset pairs
+       * (hs[q], hs[NO + q]) with o[hs[NO + q]] = o[hs[q]] + @p delta
+       * (@p delta > 0 a multiple of 8) over the groups g = g_begin ..
+       * g_end - 1 of the chunk at c0 (g_begin >= delta / 8): offset hs[q]
+       * from the group's positions v = 8 g, offset hs[NO + q] from
+       * v - delta. Both bonds of a pair end at the same positions v + o_q,
+       * so their reactions are summed in registers and stored once (one
+       * unaligned read-modify-write per two bond vectors instead of one
+       * per vector, and two force updates per 2 NO vectors); the groups
+       * below g_begin (first offsets) and the last delta / 8 groups (second
+       * offsets) are the caller's, e.g. sweep_offsets() on either half. The
+       * arguments and the arithmetic of a bond are those of sweep_offsets()
+       * (bitwise the same stretch, scale and breaking); only the order in
+       * which the forces and reactions of different offsets are summed
+       * differs. All bonds of a group pair are evaluated when any of its
+       * bits is set (the dead lanes contribute 0).
+       */
+      template <int dim, int NO, typename Broken>
+      __attribute__((noinline)) void
+      sweep_offset_pairs(const double        *p,
+                         double              *reaction,
+                         double              *acc,
+                         const LiveBits      &bits,
+                         const std::size_t    N,
+                         const unsigned int   C,
+                         const std::size_t    c0,
+                         const unsigned int   g_begin,
+                         const unsigned int   g_end,
+                         const std::int64_t  *o,
+                         const unsigned int  *hs,
+                         const std::int64_t   delta,
+                         const double        *k,
+                         const double        *r,
+                         const double         s0,
+                         Broken              &broken)
+      {
+        using Position = typename Broken::value_type::second_type;
+        Assert(delta > 0 && delta % 8 == 0 && std::int64_t(g_begin) >= delta / 8,
+               dealii::ExcInternalError());
+        // The layout of sweep_offsets() (one base pointer per stream, the
+        // constants as embedded broadcasts through an opaque pointer).
+        const std::size_t   gs = bits.group_stride;
+        std::uint8_t *const B  = bits.live + c0 / 8 * gs;
+        std::size_t         bq[2 * NO];
+        std::int64_t        oq[NO];
+        double              cst[2 * NO][3]; // k, k r, (r + s0 r)^2
+        const double       *P[dim];
+        double             *Rb[dim], *A[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            P[d]  = p + d * N + c0;
+            Rb[d] = reaction + d * N + c0;
+            A[d]  = acc + d * C;
+          }
+        for (int q = 0; q < 2 * NO; ++q)
+          {
+            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
+            pmb_offset_constants(r[hs[q]], k[hs[q]], s0, cst[q][1], cst[q][2]);
+            cst[q][0] = k[hs[q]];
+          }
+        for (int q = 0; q < NO; ++q)
+          {
+            oq[q] = o[hs[q]];
+            Assert(o[hs[NO + q]] == oq[q] + delta, dealii::ExcInternalError());
+          }
+        const std::size_t dbits = delta / 8 * gs;
+        for (std::size_t g = g_begin; g < g_end; ++g)
+          {
+            const std::size_t   v  = 8 * g;
+            std::uint8_t *const Ba = B + g * gs, *const Bb = Ba - dbits;
+            __mmask8            alive[2 * NO], any = 0;
+#  pragma GCC unroll 4
+            for (int q = 0; q < NO; ++q)
+              {
+                any |= alive[q] = Ba[bq[q]];
+                any |= alive[NO + q] = Bb[bq[NO + q]];
+              }
+            if (any == 0)
+              continue;
+            const double(*c)[3] = cst;
+            asm("" : "+r"(c));
+            __m512d pa[dim], fa[dim], pb[dim], fb[dim];
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                pa[d] = _mm512_loadu_pd(P[d] + v);
+                fa[d] = _mm512_load_pd(A[d] + v);
+                pb[d] = _mm512_loadu_pd(P[d] + v - delta);
+                fb[d] = _mm512_load_pd(A[d] + v - delta);
+              }
+#  pragma GCC unroll 4
+            for (int q = 0; q < NO; ++q)
+              {
+                if ((alive[q] | alive[NO + q]) == 0)
+                  continue;
+                std::int64_t j = std::int64_t(v) + oq[q];
+                asm("" : "+r"(j));
+                __m512d ya[dim], yb[dim];
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    const __m512d pj = _mm512_loadu_pd(P[d] + j);
+                    ya[d]            = _mm512_sub_pd(pj, pa[d]);
+                    yb[d]            = _mm512_sub_pd(pj, pb[d]);
+                  }
+                __m512d la = _mm512_mul_pd(ya[0], ya[0]), lb = _mm512_mul_pd(yb[0], yb[0]);
+                for (unsigned int d = 1; d < dim; ++d)
+                  {
+                    la = _mm512_fmadd_pd(ya[d], ya[d], la);
+                    lb = _mm512_fmadd_pd(yb[d], yb[d], lb);
+                  }
+                __mmask8      brka, brkb;
+                const __m512d sa = pmb_bond_scale_kr<false>(la,
+                                                            alive[q],
+                                                            _mm512_set1_pd(c[q][0]),
+                                                            _mm512_set1_pd(c[q][1]),
+                                                            _mm512_set1_pd(c[q][2]),
+                                                            brka);
+                const __m512d sb = pmb_bond_scale_kr<false>(lb,
+                                                            alive[NO + q],
+                                                            _mm512_set1_pd(c[NO + q][0]),
+                                                            _mm512_set1_pd(c[NO + q][1]),
+                                                            _mm512_set1_pd(c[NO + q][2]),
+                                                            brkb);
+                for (unsigned int d = 0; d < dim; ++d)
+                  {
+                    double *rd = Rb[d] + j;
+                    fa[d]      = _mm512_fmadd_pd(sa, ya[d], fa[d]);
+                    fb[d]      = _mm512_fmadd_pd(sb, yb[d], fb[d]);
+                    _mm512_storeu_pd(rd,
+                                     _mm512_fmadd_pd(sb,
+                                                     yb[d],
+                                                     _mm512_fmadd_pd(sa, ya[d], _mm512_loadu_pd(rd))));
+                  }
+                if (__builtin_expect((brka | brkb) != 0, 0))
+                  {
+                    Ba[bq[q]]      = alive[q] & ~brka;
+                    Bb[bq[NO + q]] = alive[NO + q] & ~brkb;
+                    for (unsigned int l = 0; l < 8; ++l)
+                      {
+                        if ((brka >> l) & 1u)
+                          broken.emplace_back(hs[q], Position(c0 + v + l));
+                        if ((brkb >> l) & 1u)
+                          broken.emplace_back(hs[NO + q], Position(c0 + v - delta + l));
+                      }
+                  }
+              }
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                _mm512_store_pd(A[d] + v, fa[d]);
+                _mm512_store_pd(A[d] + v - delta, fb[d]);
+              }
+          }
+      }
     } // namespace LatticeSweep
   }   // namespace internal
 } // namespace PeriDEAL
