@@ -352,6 +352,7 @@ namespace PeriDEAL
       // Each node's own coefficients per cloud entry (V_G, V_H of levels n
       // and n-1); store_updating_vectors() keeps one set per class.
       std::vector<double> vg_now, vg_old, vh_now, vh_old;
+      std::vector<std::vector<std::array<double, dim + 3>>> node_modes(absorbing.size());
       info.clear();
       stats = WaveCloudStatistics();
 
@@ -454,6 +455,16 @@ namespace PeriDEAL
                 }
             }
           const unsigned int n_all = kvec.size();
+          for (unsigned int c = 0; c < n_all; ++c)
+            {
+              std::array<double, dim + 3> m;
+              for (unsigned int d = 0; d < dim; ++d)
+                m[d] = kvec[c][d];
+              m[dim]     = omega[c].real();
+              m[dim + 1] = omega[c].imag();
+              m[dim + 2] = decay[c];
+              node_modes[a].push_back(m);
+            }
           const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int c) {
             const std::complex<double> I(0., 1.);
             return std::exp(-decay[c] * time + I * (kvec[c] * xbar) - I * omega[c] * time);
@@ -738,7 +749,7 @@ namespace PeriDEAL
       std::vector<std::array<double, 4>> own(cloud_index.size());
       for (unsigned int c = 0; c < own.size(); ++c)
         own[c] = {{vg_now[c], vg_old[c], vh_now[c], vh_old[c]}};
-      store_updating_vectors(points, ids, normals, dx, own, prm.share_updating_vectors, comm);
+      store_updating_vectors(points, ids, normals, dx, own, node_modes, prm.share_updating_vectors, comm);
       all_cloud_points = cloud_index;
       std::sort(all_cloud_points.begin(), all_cloud_points.end());
       all_cloud_points.erase(std::unique(all_cloud_points.begin(), all_cloud_points.end()),
@@ -754,11 +765,13 @@ namespace PeriDEAL
 
     template <int dim>
     void
-    EbfWaveAbc<dim>::store_updating_vectors(const std::vector<Point<dim>>              &points,
-                                            const std::vector<types::global_dof_index> &ids,
-                                            const std::vector<Tensor<1, dim>>          &normals,
-                                            const double                                dx,
-                                            const std::vector<std::array<double, 4>>   &own,
+    EbfWaveAbc<dim>::store_updating_vectors(
+      const std::vector<Point<dim>>                               &points,
+      const std::vector<types::global_dof_index>                  &ids,
+      const std::vector<Tensor<1, dim>>                           &normals,
+      const double                                                 dx,
+      const std::vector<std::array<double, 4>>                    &own,
+      const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
                                             const bool                                  share,
                                             const MPI_Comm                              comm)
     {
@@ -778,10 +791,14 @@ namespace PeriDEAL
         }
       // Canonical form of each cloud: the entries sorted by their quantized
       // local-frame offsets, for the frame and its mirror image (2D), the
-      // smaller key kept. The key also holds the quantized own coefficients,
-      // so that clouds with congruent points but other mode sets (e.g.
-      // anisotropic frequencies) or thinning weights stay apart.
-      const double offset_step = std::ldexp(dx, -20), coefficient_step = std::ldexp(1., -20);
+      // smaller key kept. The key also holds the node's modes (the sorted
+      // quantized wave vectors in the same frame, frequencies and decay
+      // rates: the discrete relation is anisotropic) and, as a guard (e.g.
+      // other thinning weights), the own coefficients coarsely quantized.
+      // The steps lie far above the round-off differences of symmetric
+      // clouds (~1e-14 dx, 1e-16, ~eps cond), so that these are rarely split.
+      const double offset_step = std::ldexp(dx, -20), mode_step = std::ldexp(1., -26),
+                   coefficient_step = std::ldexp(1., -10);
       const auto   quantize    = [](const double x, const double step) {
         return static_cast<long long>(std::llround(x / step));
       };
@@ -824,6 +841,13 @@ namespace PeriDEAL
                   for (const double v : own[begin + c])
                     key.push_back(quantize(v, coefficient_step));
                 }
+              std::vector<std::array<long long, dim + 3>> qm(modes[a].size());
+              for (unsigned int c = 0; c < qm.size(); ++c)
+                for (unsigned int d = 0; d < dim + 3; ++d)
+                  qm[c][d] = quantize((mirror == 1 && d == dim - 1 ? -1. : 1.) * modes[a][c][d], mode_step);
+              std::sort(qm.begin(), qm.end());
+              for (const auto &m : qm)
+                key.insert(key.end(), m.begin(), m.end());
               if (mirror == 0 || key < best_key)
                 {
                   best_key.swap(key);

@@ -294,8 +294,9 @@ namespace PeriDEAL
      * Shared updating vectors (WaveAbcParameters::share_updating_vectors):
      * nodes whose final clouds are congruent in their local frames (the same
      * offsets R (x_j - x_i), possibly after the reflection y bar -> -y bar,
-     * to 2^-20 dx, and their own coefficients the same to 2^-20) have the
-     * same moment matrices up to round-off, so only one set of coefficients
+     * to 2^-20 dx), with the same modes (local wave vectors, frequencies and
+     * decay rates to 2^-26) and their own coefficients the same to 2^-10,
+     * have the same moment matrices up to round-off, so only one set of coefficients
      * per such class is stored, with the cloud of each node listed in the
      * class's canonical order (offsets sorted). The stored set is the own
      * fit of the class member with the smallest global id over all ranks,
@@ -374,14 +375,17 @@ namespace PeriDEAL
       /**
        * Group the clouds into classes and store one coefficient set per
        * class (one per node if @p share is false); @p own: each node's
-       * coefficients (V_G, V_H of levels n and n-1) per entry of cloud_index.
+       * coefficients (V_G, V_H of levels n and n-1) per entry of cloud_index;
+       * @p modes: each node's modes (local wave vector, Re and Im of the
+       * frequency, decay rate).
        */
       void
-      store_updating_vectors(const std::vector<Point<dim>>              &points,
-                             const std::vector<types::global_dof_index> &ids,
-                             const std::vector<Tensor<1, dim>>          &normals,
-                             const double                                dx,
-                             const std::vector<std::array<double, 4>>   &own,
+      store_updating_vectors(const std::vector<Point<dim>>                          &points,
+                             const std::vector<types::global_dof_index>             &ids,
+                             const std::vector<Tensor<1, dim>>                      &normals,
+                             const double                                            dx,
+                             const std::vector<std::array<double, 4>>               &own,
+                             const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
                              const bool                                  share,
                              const MPI_Comm                              comm);
 
