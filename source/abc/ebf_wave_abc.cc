@@ -772,8 +772,8 @@ namespace PeriDEAL
       const double                                                 dx,
       const std::vector<std::array<double, 4>>                    &own,
       const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
-                                            const bool                                  share,
-                                            const MPI_Comm                              comm)
+      const bool                                                   share,
+      const MPI_Comm                                               comm)
     {
       const unsigned int n_nodes = absorbing.size();
       node_class.resize(n_nodes);
