@@ -12,7 +12,10 @@
 //     diffusion (the PD keys were abc_overhead_fraction_pd_{1d,2d} before).
 // Sizes: 2D PD box (-4,4)^2, dx = 1/16, delta = 4 dx (16,641 nodes,
 // 1,984 absorbing); 2D FEM Q1 lumped on (-4,4)^2 with 256^2 cells;
-// 1D: (-30,30) at dx = 0.125 as in step-5. Usage: abc_benchmark [steps].
+// 1D: (-30,30) at dx = 0.125 as in step-5. Usage: abc_benchmark [steps]
+// [--wave-only] [--no-share] (--wave-only: only the PD wave keys; --no-share:
+// one set of updating vectors per absorbing node instead of per class of
+// congruent clouds, for A/B runs).
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/mpi.h>
@@ -28,6 +31,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <iostream>
+#include <string>
 #include <vector>
 
 using namespace dealii;
@@ -88,6 +92,10 @@ median(std::vector<double> x)
 struct WaveOverhead
 {
   double fraction = 0., fraction_vs_no_abc = 0., step_seconds = 0., step_seconds_no_abc = 0.;
+  /** Coefficient sets stored (classes of congruent clouds) and absorbing nodes. */
+  types::global_dof_index n_classes = 0, n_clouds = 0;
+  /** Largest relative change of the updating vectors by the sharing. */
+  double shared_difference = 0.;
 };
 
 // fraction: the timers of advance(), abc_seconds / step_seconds (wall), over
@@ -102,7 +110,7 @@ struct WaveOverhead
 // order, each block after one untimed step in its mode. Per round,
 // (T_abc - T_none) / T_abc; the key is the median over the rounds.
 WaveOverhead
-pd_wave_fraction(const double R, const unsigned int steps)
+pd_wave_fraction(const double R, const unsigned int steps, const bool share)
 {
   LatticeParameters lp;
   lp.dx    = 0.25;
@@ -112,10 +120,14 @@ pd_wave_fraction(const double R, const unsigned int steps)
   mp.damping   = 0.0125;
   mp.time_step = 0.02;
   Abc::WaveAbcParameters ap;
-  ap.cone_angle = 0.5;
+  ap.cone_angle             = 0.5;
+  ap.share_updating_vectors = share;
   Abc::PdUnboundedWave<2> run(MPI_COMM_WORLD);
   run.setup(BallDomain<2>(Point<2>(), R), lp, mp, Abc::WaveTruncation::absorbing, ap, Gaussian<2>());
   WaveOverhead o;
+  o.n_classes = run.absorbing_boundary().statistics().n_classes;
+  o.n_clouds  = run.absorbing_boundary().statistics().n_absorbing;
+  o.shared_difference = run.absorbing_boundary().statistics().max_shared_difference;
   for (unsigned int n = 0; n < steps / 4; ++n)
     run.advance();
   o.fraction = Utilities::MPI::sum(run.abc_seconds, MPI_COMM_WORLD) /
@@ -166,20 +178,36 @@ int
 main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  const unsigned int steps = argc > 1 ? std::atoi(argv[1]) : 2000;
-  const WaveOverhead wave2 = pd_wave_fraction(26., steps);
+  unsigned int steps = 2000;
+  bool         wave_only = false, share = true;
+  for (int i = 1; i < argc; ++i)
+    {
+      const std::string arg = argv[i];
+      if (arg == "--wave-only")
+        wave_only = true;
+      else if (arg == "--no-share")
+        share = false;
+      else
+        steps = std::atoi(argv[i]);
+    }
+  const WaveOverhead wave2 = pd_wave_fraction(26., steps, share);
+  if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+    std::cout << "abc_overhead_fraction_pd_2d: " << wave2.fraction << "\n"
+              << "abc_overhead_fraction_pd_2d_vs_no_abc: " << wave2.fraction_vs_no_abc << "\n"
+              << "abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds << "\n"
+              << "no_abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds_no_abc << "\n"
+              << "abc_updating_vector_sets_pd_2d: " << wave2.n_classes << "\n"
+              << "abc_clouds_pd_2d: " << wave2.n_clouds << "\n"
+              << "abc_shared_updating_vector_difference_pd_2d: " << wave2.shared_difference << std::endl;
+  if (wave_only)
+    return 0;
   const double pd2 = pd_fraction<2>(4., 1. / 16., steps);
   const double pd1 = pd_fraction<1>(30., 0.125, 20 * steps);
-  double fem2 = 0., fem1 = 0.;
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
     {
-      fem2 = fem_fraction<2>(4., 256, steps);
-      fem1 = fem_fraction<1>(30., 480, 20 * steps);
-      std::cout << "abc_overhead_fraction_pd_2d: " << wave2.fraction << "\n"
-                << "abc_overhead_fraction_pd_2d_vs_no_abc: " << wave2.fraction_vs_no_abc << "\n"
-                << "abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds << "\n"
-                << "no_abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds_no_abc << "\n"
-                << "abc_overhead_fraction_pd_diffusion_2d: " << pd2 << "\n"
+      const double fem2 = fem_fraction<2>(4., 256, steps);
+      const double fem1 = fem_fraction<1>(30., 480, 20 * steps);
+      std::cout << "abc_overhead_fraction_pd_diffusion_2d: " << pd2 << "\n"
                 << "abc_overhead_fraction_pd_diffusion_1d: " << pd1 << "\n"
                 << "abc_overhead_fraction_fem_2d: " << fem2 << "\n"
                 << "abc_overhead_fraction_fem_1d: " << fem1 << std::endl;

@@ -114,6 +114,10 @@ namespace PeriDEAL
                         "rho into the PML.");
       prm.declare_entry("Maximum spectral radius", "1.00000001", Patterns::Double(1.),
                         "Setup throws ParameterError if the checked spectral radius exceeds this.");
+      prm.declare_entry("Share updating vectors", "true", Patterns::Bool(),
+                        "Store one set of updating vectors per class of congruent clouds (local "
+                        "frames, up to a reflection) instead of one per absorbing node: equal to "
+                        "round-off, fewer bytes per step.");
     }
 
     void
@@ -146,6 +150,7 @@ namespace PeriDEAL
       pml_damping              = prm.get_double("PML damping");
       pml_thickness            = prm.get_double("PML thickness");
       pml_exponent             = prm.get_double("PML exponent");
+      share_updating_vectors   = prm.get_bool("Share updating vectors");
     }
 
 
@@ -349,10 +354,10 @@ namespace PeriDEAL
       absorbing = absorbing_in;
       cloud_start.assign(1, 0);
       cloud_index.clear();
-      vg_now.clear();
-      vg_old.clear();
-      vh_now.clear();
-      vh_old.clear();
+      // Each node's own coefficients per cloud entry (V_G, V_H of levels n
+      // and n-1); store_updating_vectors() keeps one set per class.
+      std::vector<double> vg_now, vg_old, vh_now, vh_old;
+      std::vector<std::vector<std::array<double, dim + 3>>> node_modes(absorbing.size());
       info.clear();
       stats = WaveCloudStatistics();
 
@@ -455,6 +460,16 @@ namespace PeriDEAL
                 }
             }
           const unsigned int n_all = kvec.size();
+          for (unsigned int c = 0; c < n_all; ++c)
+            {
+              std::array<double, dim + 3> m;
+              for (unsigned int d = 0; d < dim; ++d)
+                m[d] = kvec[c][d];
+              m[dim]     = omega[c].real();
+              m[dim + 1] = omega[c].imag();
+              m[dim + 2] = decay[c];
+              node_modes[a].push_back(m);
+            }
           const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int c) {
             const std::complex<double> I(0., 1.);
             return std::exp(-decay[c] * time + I * (kvec[c] * xbar) - I * omega[c] * time);
@@ -752,6 +767,10 @@ namespace PeriDEAL
             }
           cloud_start.push_back(cloud_index.size());
         }
+      std::vector<std::array<double, 4>> own(cloud_index.size());
+      for (unsigned int c = 0; c < own.size(); ++c)
+        own[c] = {{vg_now[c], vg_old[c], vh_now[c], vh_old[c]}};
+      store_updating_vectors(points, ids, normals, dx, own, node_modes, prm.share_updating_vectors, comm);
       all_cloud_points = cloud_index;
       std::sort(all_cloud_points.begin(), all_cloud_points.end());
       all_cloud_points.erase(std::unique(all_cloud_points.begin(), all_cloud_points.end()),
@@ -767,14 +786,204 @@ namespace PeriDEAL
 
     template <int dim>
     void
+    EbfWaveAbc<dim>::store_updating_vectors(
+      const std::vector<Point<dim>>                               &points,
+      const std::vector<types::global_dof_index>                  &ids,
+      const std::vector<Tensor<1, dim>>                           &normals,
+      const double                                                 dx,
+      const std::vector<std::array<double, 4>>                    &own,
+      const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
+      const bool                                                   share,
+      const MPI_Comm                                               comm)
+    {
+      const unsigned int n_nodes = absorbing.size();
+      node_class.resize(n_nodes);
+      class_start.assign(1, 0);
+      coefficients.clear();
+      stats.max_shared_difference = 0.;
+      if (!share)
+        {
+          for (unsigned int a = 0; a < n_nodes; ++a)
+            node_class[a] = a;
+          class_start = cloud_start;
+          coefficients = own;
+          stats.n_classes = Utilities::MPI::sum<types::global_dof_index>(n_nodes, comm);
+          return;
+        }
+      // Canonical form of each cloud: the entries sorted by their quantized
+      // local-frame offsets, for the frame and its mirror image (2D), the
+      // smaller key kept. The key also holds the node's modes (the sorted
+      // quantized wave vectors in the same frame, frequencies and decay
+      // rates: the discrete relation is anisotropic) and, as a guard (e.g.
+      // other thinning weights), the own coefficients coarsely quantized.
+      // The steps lie far above the round-off differences of symmetric
+      // clouds (~1e-14 dx, 1e-16, ~eps cond), so that these are rarely split.
+      const double offset_step = std::ldexp(dx, -20), mode_step = std::ldexp(1., -26),
+                   coefficient_step = std::ldexp(1., -10);
+      const auto   quantize    = [](const double x, const double step) {
+        return static_cast<long long>(std::llround(x / step));
+      };
+      std::map<std::vector<long long>, unsigned int> local_class;
+      // Per local class: the smallest global id of its members and that
+      // member's coefficients in canonical order.
+      std::vector<types::global_dof_index>             class_id;
+      std::vector<std::vector<std::array<double, 4>>> class_coefficients;
+      std::vector<std::vector<long long>>              class_key;
+      std::vector<unsigned int>                        new_index(cloud_index.size());
+      std::vector<unsigned int>                        order;
+      for (unsigned int a = 0; a < n_nodes; ++a)
+        {
+          const unsigned int   begin = cloud_start[a], n = cloud_start[a + 1] - begin;
+          const Tensor<2, dim> R     = local_frame(normals[a]);
+          std::vector<std::array<long long, dim>> q(n);
+          for (unsigned int c = 0; c < n; ++c)
+            {
+              const Tensor<1, dim> off = R * (points[cloud_index[begin + c]] - points[absorbing[a]]);
+              for (unsigned int d = 0; d < dim; ++d)
+                q[c][d] = quantize(off[d], offset_step);
+            }
+          std::vector<long long>    best_key;
+          std::vector<unsigned int> best_order;
+          for (unsigned int mirror = 0; mirror < (dim == 2 ? 2u : 1u); ++mirror)
+            {
+              if (mirror == 1)
+                for (auto &p : q)
+                  p[dim - 1] = -p[dim - 1];
+              order.resize(n);
+              for (unsigned int c = 0; c < n; ++c)
+                order[c] = c;
+              std::sort(order.begin(), order.end(), [&q](const unsigned int x, const unsigned int y) {
+                return q[x] < q[y];
+              });
+              std::vector<long long> key{n};
+              for (const unsigned int c : order)
+                {
+                  key.insert(key.end(), q[c].begin(), q[c].end());
+                  for (const double v : own[begin + c])
+                    key.push_back(quantize(v, coefficient_step));
+                }
+              std::vector<std::array<long long, dim + 3>> qm(modes[a].size());
+              for (unsigned int c = 0; c < qm.size(); ++c)
+                for (unsigned int d = 0; d < dim + 3; ++d)
+                  qm[c][d] = quantize((mirror == 1 && d == dim - 1 ? -1. : 1.) * modes[a][c][d], mode_step);
+              std::sort(qm.begin(), qm.end());
+              for (const auto &m : qm)
+                key.insert(key.end(), m.begin(), m.end());
+              if (mirror == 0 || key < best_key)
+                {
+                  best_key.swap(key);
+                  best_order = order;
+                }
+            }
+          for (unsigned int c = 0; c < n; ++c)
+            new_index[begin + c] = cloud_index[begin + best_order[c]];
+          const auto [it, inserted] = local_class.emplace(best_key, class_id.size());
+          const types::global_dof_index id = ids[absorbing[a]];
+          if (inserted || id < class_id[it->second])
+            {
+              if (inserted)
+                {
+                  class_id.push_back(id);
+                  class_coefficients.emplace_back();
+                  class_key.push_back(best_key);
+                }
+              class_id[it->second] = id;
+              auto &cf             = class_coefficients[it->second];
+              cf.resize(n);
+              for (unsigned int c = 0; c < n; ++c)
+                cf[c] = own[begin + best_order[c]];
+            }
+          node_class[a] = it->second;
+        }
+      // Over all ranks, the member with the smallest global id provides the
+      // coefficients of its class (flattened keys, ids and coefficients).
+      std::map<std::vector<long long>, std::pair<types::global_dof_index, std::vector<std::array<double, 4>>>>
+        global_class;
+      if (Utilities::MPI::n_mpi_processes(comm) > 1)
+        {
+          std::vector<long long> flat_keys;
+          std::vector<double>    flat_values;
+          for (unsigned int k = 0; k < class_key.size(); ++k)
+            {
+              flat_keys.push_back(class_key[k].size());
+              flat_keys.insert(flat_keys.end(), class_key[k].begin(), class_key[k].end());
+              flat_keys.push_back(static_cast<long long>(class_id[k]));
+              for (const auto &cf : class_coefficients[k])
+                flat_values.insert(flat_values.end(), cf.begin(), cf.end());
+            }
+          const auto all_keys   = Utilities::MPI::all_gather(comm, flat_keys);
+          const auto all_values = Utilities::MPI::all_gather(comm, flat_values);
+          for (unsigned int r = 0; r < all_keys.size(); ++r)
+            {
+              std::size_t kp = 0, vp = 0;
+              while (kp < all_keys[r].size())
+                {
+                  const std::size_t      len = all_keys[r][kp++];
+                  std::vector<long long> key(all_keys[r].begin() + kp, all_keys[r].begin() + kp + len);
+                  kp += len;
+                  const auto id = static_cast<types::global_dof_index>(all_keys[r][kp++]);
+                  const unsigned int n = key[0];
+                  auto [it, inserted] = global_class.try_emplace(std::move(key));
+                  if (inserted || id < it->second.first)
+                    {
+                      it->second.first = id;
+                      it->second.second.resize(n);
+                      for (unsigned int c = 0; c < n; ++c)
+                        for (unsigned int v = 0; v < 4; ++v)
+                          it->second.second[c][v] = all_values[r][vp + 4 * c + v];
+                    }
+                  vp += 4 * n;
+                }
+            }
+          for (unsigned int k = 0; k < class_key.size(); ++k)
+            class_coefficients[k] = global_class.at(class_key[k]).second;
+        }
+      stats.n_classes = global_class.empty() ? class_key.size() : global_class.size();
+      for (unsigned int k = 0; k < class_key.size(); ++k)
+        {
+          class_start.push_back(class_start.back() + class_coefficients[k].size());
+          coefficients.insert(coefficients.end(), class_coefficients[k].begin(), class_coefficients[k].end());
+        }
+      // What sharing changed against each node's own coefficients.
+      double max_difference = 0.;
+      for (unsigned int a = 0; a < n_nodes; ++a)
+        {
+          const unsigned int begin = cloud_start[a], n = cloud_start[a + 1] - begin;
+          std::array<double, 4> scale{}, difference{};
+          for (unsigned int c = 0; c < n; ++c)
+            {
+              // The own coefficient of the point now at canonical entry c.
+              unsigned int e = begin;
+              while (cloud_index[e] != new_index[begin + c])
+                ++e;
+              const auto &shared = coefficients[class_start[node_class[a]] + c];
+              for (unsigned int v = 0; v < 4; ++v)
+                {
+                  scale[v]      = std::max(scale[v], std::abs(own[e][v]));
+                  difference[v] = std::max(difference[v], std::abs(shared[v] - own[e][v]));
+                }
+            }
+          for (unsigned int v = 0; v < 4; ++v)
+            if (scale[v] > 0.)
+              max_difference = std::max(max_difference, difference[v] / scale[v]);
+        }
+      stats.max_shared_difference = Utilities::MPI::max(max_difference, comm);
+      cloud_index.swap(new_index);
+    }
+
+    template <int dim>
+    void
     EbfWaveAbc<dim>::compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const
     {
       u_new.resize(absorbing.size());
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
-          double su = 0.;
-          for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
-            su += vg_now[c] * u[cloud_index[c]] + vg_old[c] * u_old[cloud_index[c]];
+          const std::array<double, 4> *cf  = coefficients.data() + class_start[node_class[a]];
+          const unsigned int          *idx = cloud_index.data() + cloud_start[a];
+          const unsigned int           n   = cloud_start[a + 1] - cloud_start[a];
+          double                       su  = 0.;
+          for (unsigned int c = 0; c < n; ++c)
+            su += cf[c][0] * u[idx[c]] + cf[c][1] * u_old[idx[c]];
           u_new[a] = su;
         }
     }
@@ -792,12 +1001,17 @@ namespace PeriDEAL
       v_new.resize(absorbing.size());
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
-          double su = 0., sv = 0.;
-          for (unsigned int c = cloud_start[a]; c < cloud_start[a + 1]; ++c)
+          // The class's coefficients in canonical order, the node's cloud
+          // points in the same order.
+          const std::array<double, 4> *cf  = coefficients.data() + class_start[node_class[a]];
+          const unsigned int          *idx = cloud_index.data() + cloud_start[a];
+          const unsigned int           n   = cloud_start[a + 1] - cloud_start[a];
+          double                       su = 0., sv = 0.;
+          for (unsigned int c = 0; c < n; ++c)
             {
-              const unsigned int j = cloud_index[c];
-              su += vg_now[c] * u[j] + vg_old[c] * u_old[j];
-              sv += vh_now[c] * v[j] + vh_old[c] * v_old[j];
+              const unsigned int j = idx[c];
+              su += cf[c][0] * u[j] + cf[c][1] * u_old[j];
+              sv += cf[c][2] * v[j] + cf[c][3] * v_old[j];
             }
           u_new[a] = su;
           v_new[a] = sv;

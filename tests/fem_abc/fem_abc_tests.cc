@@ -74,7 +74,8 @@ namespace
     const auto     &st = ebf.absorbing_boundary().statistics();
     if (verbose && root())
       std::cout << "    EBF (" << ebf.dispersion().name << "): " << st.n_absorbing << " absorbing DoFs, clouds "
-                << st.min_cloud_size << ".." << st.max_cloud_size << " stride " << st.max_stride << ", cond "
+                << st.min_cloud_size << ".." << st.max_cloud_size << " stride " << st.max_stride << ", " << st.n_classes
+                << " coefficient sets, cond "
                 << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     const auto inside = [&](const Point<2> &p) { return std::max(std::abs(p[0]), std::abs(p[1])) < c.L - 1e-9; };
     const double       e0      = ref.energy(inside);

@@ -1,6 +1,6 @@
 perideal_add_test_program(wave_abc_tests ${CMAKE_CURRENT_LIST_DIR}/wave_abc_tests.cc)
 
-foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped)
+foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped shared_vectors)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS unit)
 endforeach()
 foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
@@ -12,6 +12,8 @@ endforeach()
 foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
+perideal_add_test(NAME wave_abc.shared_vectors.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:wave_abc_tests> shared_vectors LABELS mpi)
 perideal_add_test(NAME wave_abc.pd_2d_ranks.np2 NPROCS 2
   COMMAND $<TARGET_FILE:wave_abc_tests> pd_2d_ranks LABELS mpi)
 # step-7 with a reduced near field (radius 6, t_end = 12).

@@ -18,10 +18,14 @@
 
 #include "../check.h"
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
+#include <numeric>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -51,6 +55,12 @@ namespace
   constexpr double PML_FIELD = 2.2e-4;
   /** PML energy left on the small disc after 5000 steps: measured 2.2e-8 E0. */
   constexpr double PML_SHORT_ENERGY = 1e-6;
+  /**
+   * Shared updating vectors (E14 disc R = 6, t = 2R): largest difference of
+   * the fields (per max |u|) and energies (per E0) from those with each
+   * node's own vectors. Measured 3.6e-10 and 2.1e-11.
+   */
+  constexpr double SHARED_FIELD = 1e-9;
 
   ScalarKernel
   wave_kernel(const unsigned int dim, const double exponent, const InfluenceFunction omega,
@@ -278,8 +288,12 @@ namespace
            const bool                                       keep_fields = true,
            const MPI_Comm                                   comm        = MPI_COMM_WORLD)
   {
+    // WAVE_ABC_OWN_VECTORS set: one set of updating vectors per node (the
+    // before-sharing path, bitwise the old results) for A/B comparisons.
+    WaveAbcParameters prm                 = abc;
+    prm.share_updating_vectors = prm.share_updating_vectors && !std::getenv("WAVE_ABC_OWN_VECTORS");
     PdUnboundedWave<dim> pd(comm);
-    pd.setup(domain, lattice, model, truncation, abc, u0);
+    pd.setup(domain, lattice, model, truncation, prm, u0);
     History<dim>       h;
     const unsigned int n_steps = static_cast<unsigned int>(std::round(final_time / model.time_step));
     const auto         all     = [](const Point<dim> &) { return true; };
@@ -515,7 +529,7 @@ namespace
     if (root())
       std::cout << "    A: cond " << sci(A.stats.max_condition_number) << " max|V| " << sci(A.stats.max_update_norm)
                 << " clouds " << A.stats.min_cloud_size << ".." << A.stats.max_cloud_size << " thinned " << A.stats.n_thinned
-                << " stride " << A.stats.max_stride << " absorbing " << A.stats.n_absorbing << " modes " << A.stats.n_modes
+                << " stride " << A.stats.max_stride << " absorbing " << A.stats.n_absorbing << " coefficient sets " << A.stats.n_classes << " modes " << A.stats.n_modes
                 << " energy increase " << sci(max_energy_increase(A.total_energy)) << " abc fraction " << A.abc_fraction << "\n"
                 << "    B: cond " << sci(B.stats.max_condition_number) << " max|V| " << sci(B.stats.max_update_norm)
                 << " thinned " << B.stats.n_thinned << " energy increase " << sci(max_energy_increase(B.total_energy)) << std::endl;
@@ -627,7 +641,7 @@ namespace
     const auto &st = ebf.absorbing_boundary().statistics();
     if (root())
       std::cout << "    EBF: " << st.n_absorbing << " absorbing DoFs, clouds " << st.min_cloud_size << ".." << st.max_cloud_size
-                << " stride " << st.max_stride << ", cond " << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
+                << " stride " << st.max_stride << ", " << st.n_classes << " coefficient sets, cond " << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     const double       e0      = ref.energy(inside);
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
     const Point<2>     probe(0.625 * L, 0.3125 * L); // (20, 10) scaled from L = 32 to L
@@ -1313,6 +1327,83 @@ namespace
     check(diff_ebf > 1e-6, "ABC active: differs from the free truncation (" + sci(diff_ebf) + ")");
   }
 
+  // Shared updating vectors (issue 4, doc/benchmarks.md session 11): on a
+  // disc centred at a lattice node the normals are radial and the clouds
+  // (cones behind the node, inside the disc) depend only on the normal, so
+  // two absorbing nodes have congruent clouds exactly when their directions
+  // from the centre are related by one of the 8 lattice symmetries: nodes on
+  // one ray share their cloud by translation, symmetric rays by rotation or
+  // reflection. The expected number of classes is therefore the number of
+  // orbits of the reduced directions (x, y)/gcd(x, y) under x <-> y and the
+  // sign changes, counted here from the node positions alone. The shared
+  // coefficients are each node's own fit up to round-off, and so are fields
+  // and energies.
+  void
+  shared_vectors()
+  {
+    const char  *env = std::getenv("SHARED_RADIUS");
+    const double R   = env ? std::atof(env) : 6.;
+    WaveAbcParameters shared_prm, own_prm;
+    shared_prm.cone_angle = own_prm.cone_angle = 0.5;
+    own_prm.share_updating_vectors             = false;
+    PdUnboundedWave<2> shared(MPI_COMM_WORLD), own(MPI_COMM_WORLD);
+    setup_e14_disc(shared, R, WaveTruncation::absorbing, shared_prm);
+    setup_e14_disc(own, R, WaveTruncation::absorbing, own_prm);
+    const double dx = 0.25;
+    std::vector<long long> local;
+    const auto            &abc = shared.absorbing_boundary();
+    for (const unsigned int i : abc.absorbing_points())
+      for (unsigned int d = 0; d < 2; ++d)
+        local.push_back(std::llround(shared.discretization().position[i][d] / dx));
+    std::set<std::array<long long, 2>> orbits, directions;
+    for (const auto &part : Utilities::MPI::all_gather(MPI_COMM_WORLD, local))
+      for (std::size_t k = 0; k < part.size(); k += 2)
+        {
+          const long long x = std::abs(part[k]), y = std::abs(part[k + 1]), g = std::gcd(x, y);
+          orbits.insert(std::array<long long, 2>{{std::min(x, y), std::max(x, y)}});
+          directions.insert(std::array<long long, 2>{{std::min(x, y) / g, std::max(x, y) / g}});
+        }
+    const auto &st = abc.statistics(), &st_own = own.absorbing_boundary().statistics();
+    if (root())
+      std::cout << "    disc R = " << R << ": " << st.n_absorbing << " absorbing nodes, " << orbits.size()
+                << " orbits under the lattice symmetries, " << st.n_classes << " classes (own: " << st_own.n_classes
+                << "), " << directions.size() << " orbits of their directions, max |V_shared - V_own| / max |V_own| = "
+                << sci(st.max_shared_difference) << " (largest condition number " << sci(st.max_condition_number) << ")"
+                << std::endl;
+    check(st_own.n_classes == st_own.n_absorbing, "without sharing one coefficient set per absorbing node");
+    check(st.n_classes == directions.size(), "classes = orbits of the node directions under the 8 lattice symmetries (" +
+                                               std::to_string(st.n_classes) + " vs " + std::to_string(directions.size()) + ")");
+    check(4 * st.n_classes <= st.n_absorbing, "at most a quarter of the clouds are classes");
+    // Two congruent clouds' own fits differ by round-off amplified by the
+    // conditioning, eps cond(M).
+    const double bound = std::numeric_limits<double>::epsilon() * st.max_condition_number;
+    check(st.max_shared_difference <= bound, "shared and own updating vectors agree to eps cond = " + sci(bound) + ": " +
+                                               sci(st.max_shared_difference));
+    // The pulse through the boundary and the reflections absorbed (t = 2R).
+    const auto   all   = [](const Point<2> &) { return true; };
+    const double e0    = shared.energy(all);
+    double       max_u = 0., diff = 0., diff_energy = 0.;
+    for (unsigned int n = 0; n < static_cast<unsigned int>(std::round(2. * R / 0.02)); ++n)
+      {
+        shared.advance();
+        own.advance();
+        if (n % 50 == 49)
+          diff_energy = std::max(diff_energy, std::abs(shared.energy(all) - own.energy(all)) / e0);
+      }
+    for (unsigned int i = 0; i < own.displacement().locally_owned_size(); ++i)
+      {
+        max_u = std::max(max_u, std::abs(own.displacement().local_element(i)));
+        diff  = std::max(diff, std::abs(shared.displacement().local_element(i) - own.displacement().local_element(i)));
+      }
+    max_u = Utilities::MPI::max(max_u, MPI_COMM_WORLD);
+    diff  = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "    t = " << shared.time() << ": max |u_shared - u_own| = " << sci(diff) << " (max |u| " << sci(max_u)
+                << "), max |E_shared - E_own| / E0 = " << sci(diff_energy) << std::endl;
+    check(diff <= SHARED_FIELD * max_u, "fields with shared and own vectors agree to " + sci(SHARED_FIELD) + " max |u|");
+    check(diff_energy <= SHARED_FIELD, "energies with shared and own vectors agree to " + sci(SHARED_FIELD) + " E0");
+  }
+
   // Energy-stable absorbing layer (issue 4, doc/design.md session 7): the
   // damping sponge u'' = L u - 2 (d + sigma(x)) u' with nothing overwritten.
   // Damped velocity Verlet is leapfrog with centred damping,
@@ -1638,6 +1729,7 @@ main(int argc, char **argv)
               {"pd_2d_notches_full", [] { pd_2d_notches(true); }},
               {"sponge", sponge},
               {"abc_skipped", abc_skipped},
+              {"shared_vectors", shared_vectors},
               {"sponge_long", sponge_long},
               {"pml", pml},
               {"pml_long", pml_long},

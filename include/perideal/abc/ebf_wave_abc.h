@@ -75,6 +75,12 @@ namespace PeriDEAL
       /** Largest admissible one-step spectral radius of the checked map. */
       double max_spectral_radius = 1. + 1e-8;
       /**
+       * Store one set of updating vectors per congruence class of clouds
+       * (EbfWaveAbc::reinit) instead of one per absorbing node: fewer
+       * coefficient bytes streamed per step, results equal to round-off.
+       */
+      bool share_updating_vectors = true;
+      /**
        * PD: "all" (the source: every point of the cone, absorbing ones
        * included) or "interior" (no absorbing point in any cloud, so that no
        * absorbing value is extrapolated from extrapolated values).
@@ -240,6 +246,17 @@ namespace PeriDEAL
       double max_update_norm = 0.;
       /** Clouds that were thinned (auxiliary-grid stride > 1) and the largest stride. */
       unsigned int n_thinned = 0, max_stride = 1;
+      /**
+       * Distinct sets of updating vectors stored, over all ranks (the
+       * congruence classes; n_absorbing without sharing).
+       */
+      types::global_dof_index n_classes = 0;
+      /**
+       * Largest max_j |V_shared,j - V_own,j| / max_j |V_own,j| over the
+       * absorbing nodes and the four coefficient vectors (V_G, V_H of both
+       * levels): what sharing changed against each node's own fit.
+       */
+      double max_shared_difference = 0.;
     };
 
     /** Guard numbers of one cloud (after thinning). */
@@ -283,6 +300,17 @@ namespace PeriDEAL
      * (condition number, max |V|) it is thinned by the nearest nodes to an
      * auxiliary grid of growing stride in the local frame
      * (Fig. 4.23) until the guards hold; otherwise ParameterError.
+     *
+     * Shared updating vectors (WaveAbcParameters::share_updating_vectors):
+     * nodes whose final clouds are congruent in their local frames (the same
+     * offsets R (x_j - x_i), possibly after the reflection y bar -> -y bar,
+     * to 2^-20 dx), with the same modes (local wave vectors, frequencies and
+     * decay rates to 2^-26) and their own coefficients the same to 2^-10,
+     * have the same moment matrices up to round-off, so only one set of coefficients
+     * per such class is stored, with the cloud of each node listed in the
+     * class's canonical order (offsets sorted). The stored set is the own
+     * fit of the class member with the smallest global id over all ranks,
+     * so it does not depend on the partition.
      */
     template <int dim>
     class EbfWaveAbc
@@ -354,9 +382,28 @@ namespace PeriDEAL
       local_frame(const Tensor<1, dim> &outward_normal);
 
     private:
+      /**
+       * Group the clouds into classes and store one coefficient set per
+       * class (one per node if @p share is false); @p own: each node's
+       * coefficients (V_G, V_H of levels n and n-1) per entry of cloud_index;
+       * @p modes: each node's modes (local wave vector, Re and Im of the
+       * frequency, decay rate).
+       */
+      void
+      store_updating_vectors(const std::vector<Point<dim>>                          &points,
+                             const std::vector<types::global_dof_index>             &ids,
+                             const std::vector<Tensor<1, dim>>                      &normals,
+                             const double                                            dx,
+                             const std::vector<std::array<double, 4>>               &own,
+                             const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
+                             const bool                                  share,
+                             const MPI_Comm                              comm);
+
       std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
-      /** Per cloud entry: V_G and V_H for levels n and n-1. */
-      std::vector<double> vg_now, vg_old, vh_now, vh_old;
+      /** Class of each absorbing node and the start of each class in coefficients. */
+      std::vector<unsigned int> node_class, class_start;
+      /** Per class entry: V_G and V_H for levels n and n-1. */
+      std::vector<std::array<double, 4>> coefficients;
       std::vector<WaveCloudInfo> info;
       WaveCloudStatistics stats;
     };
