@@ -390,14 +390,14 @@ namespace PeriDEAL
        * frequency, decay rate).
        */
       void
-      store_updating_vectors(const std::vector<Point<dim>>                          &points,
-                             const std::vector<types::global_dof_index>             &ids,
-                             const std::vector<Tensor<1, dim>>                      &normals,
-                             const double                                            dx,
-                             const std::vector<std::array<double, 4>>               &own,
+      store_updating_vectors(const std::vector<Point<dim>>                               &points,
+                             const std::vector<types::global_dof_index>                  &ids,
+                             const std::vector<Tensor<1, dim>>                           &normals,
+                             const double                                                 dx,
+                             const std::vector<std::array<double, 4>>                    &own,
                              const std::vector<std::vector<std::array<double, dim + 3>>> &modes,
-                             const bool                                  share,
-                             const MPI_Comm                              comm);
+                             const bool                                                   share,
+                             const MPI_Comm                                               comm);
 
       std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
       /** Class of each absorbing node and the start of each class in coefficients. */

@@ -157,6 +157,57 @@ namespace PeriDEAL
       }
 
       /**
+       * The stream pointers of a sweep over the chunk at c0 (P: positions,
+       * Rb: reactions, both from c0; A: the chunk's force accumulator) and,
+       * per offset hs[q], its bit slot offset and the constants of
+       * pmb_bond_scale_kr() (k, k r, (r + s0 r)^2), shared by
+       * sweep_offsets() and sweep_offset_pairs().
+       */
+      template <int dim, int n_offsets>
+      inline __attribute__((always_inline)) void
+      sweep_setup(const double       *p,
+                  double             *reaction,
+                  double             *acc,
+                  const LiveBits     &bits,
+                  const std::size_t   N,
+                  const unsigned int  C,
+                  const std::size_t   c0,
+                  const unsigned int *hs,
+                  const double       *k,
+                  const double       *r,
+                  const double        s0,
+                  const double       *(&P)[dim],
+                  double             *(&Rb)[dim],
+                  double             *(&A)[dim],
+                  std::size_t (&bq)[n_offsets],
+                  double (&cst)[n_offsets][3])
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            P[d]  = p + d * N + c0;
+            Rb[d] = reaction + d * N + c0;
+            A[d]  = acc + d * C;
+          }
+        for (int q = 0; q < n_offsets; ++q)
+          {
+            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
+            pmb_offset_constants(r[hs[q]], k[hs[q]], s0, cst[q][1], cst[q][2]);
+            cst[q][0] = k[hs[q]];
+          }
+      }
+
+      /**
+       * pmb_bond_scale_kr() without the dead-lane blend, the constants c of
+       * sweep_setup() read as embedded broadcasts.
+       */
+      inline __attribute__((always_inline)) __m512d
+      sweep_bond_scale(const __m512d l2, const __mmask8 alive, const double *c, __mmask8 &brk)
+      {
+        return pmb_bond_scale_kr<false>(
+          l2, alive, _mm512_set1_pd(c[0]), _mm512_set1_pd(c[1]), _mm512_set1_pd(c[2]), brk);
+      }
+
+      /**
        * NO positive stencil offsets hs[0], ... of a lattice sweep over the
        * groups of eight box positions of one chunk starting at c0 (a
        * multiple of 8): the groups c0 + 8 g for g = groups[0 .. n_groups)
@@ -212,19 +263,9 @@ namespace PeriDEAL
         double              cst[NO][3]; // k, k r, (r + s0 r)^2
         const double       *P[dim];
         double             *Rb[dim], *A[dim];
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            P[d]  = p + d * N + c0;
-            Rb[d] = reaction + d * N + c0;
-            A[d]  = acc + d * C;
-          }
+        sweep_setup<dim, NO>(p, reaction, acc, bits, N, C, c0, hs, k, r, s0, P, Rb, A, bq, cst);
         for (int q = 0; q < NO; ++q)
-          {
-            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
-            oq[q]            = o[hs[q]];
-            pmb_offset_constants(r[hs[q]], k[hs[q]], s0, cst[q][1], cst[q][2]);
-            cst[q][0] = k[hs[q]];
-          }
+          oq[q] = o[hs[q]];
         const auto group = [&](const std::size_t v) {
           __mmask8      alive[NO], any = 0;
           std::uint8_t *const Bv = B + v / 8 * gs;
@@ -259,12 +300,7 @@ namespace PeriDEAL
               __mmask8      brk;
               // Dead lanes need no blend: they may compute inf or NaN, but
               // return 0 (the default floating-point environment).
-              const __m512d scale = pmb_bond_scale_kr<false>(l2,
-                                                             alive[q],
-                                                             _mm512_set1_pd(c[q][0]),
-                                                             _mm512_set1_pd(c[q][1]),
-                                                             _mm512_set1_pd(c[q][2]),
-                                                             brk);
+              const __m512d scale = sweep_bond_scale(l2, alive[q], c[q], brk);
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   double *rd = Rb[d] + j;
@@ -339,18 +375,7 @@ namespace PeriDEAL
         double              cst[2 * NO][3]; // k, k r, (r + s0 r)^2
         const double       *P[dim];
         double             *Rb[dim], *A[dim];
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            P[d]  = p + d * N + c0;
-            Rb[d] = reaction + d * N + c0;
-            A[d]  = acc + d * C;
-          }
-        for (int q = 0; q < 2 * NO; ++q)
-          {
-            bq[q] = std::size_t(bits.slot ? bits.slot[hs[q]] : hs[q]) * bits.slot_stride;
-            pmb_offset_constants(r[hs[q]], k[hs[q]], s0, cst[q][1], cst[q][2]);
-            cst[q][0] = k[hs[q]];
-          }
+        sweep_setup<dim, 2 * NO>(p, reaction, acc, bits, N, C, c0, hs, k, r, s0, P, Rb, A, bq, cst);
         for (int q = 0; q < NO; ++q)
           {
             oq[q] = o[hs[q]];
@@ -401,18 +426,8 @@ namespace PeriDEAL
                     lb = _mm512_fmadd_pd(yb[d], yb[d], lb);
                   }
                 __mmask8      brka, brkb;
-                const __m512d sa = pmb_bond_scale_kr<false>(la,
-                                                            alive[q],
-                                                            _mm512_set1_pd(c[q][0]),
-                                                            _mm512_set1_pd(c[q][1]),
-                                                            _mm512_set1_pd(c[q][2]),
-                                                            brka);
-                const __m512d sb = pmb_bond_scale_kr<false>(lb,
-                                                            alive[NO + q],
-                                                            _mm512_set1_pd(c[NO + q][0]),
-                                                            _mm512_set1_pd(c[NO + q][1]),
-                                                            _mm512_set1_pd(c[NO + q][2]),
-                                                            brkb);
+                const __m512d sa = sweep_bond_scale(la, alive[q], c[q], brka);
+                const __m512d sb = sweep_bond_scale(lb, alive[NO + q], c[NO + q], brkb);
                 for (unsigned int d = 0; d < dim; ++d)
                   {
                     double *rd = Rb[d] + j;
