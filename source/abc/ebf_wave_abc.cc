@@ -93,6 +93,10 @@ namespace PeriDEAL
                         "value (the source: V = Psi(0, dt) M^+) or increment (V = e_i + "
                         "(Psi(0, dt) - Psi(0, 0)) M^+: a truncated pseudo-inverse filters only the "
                         "change over one step).");
+      prm.declare_entry("Curvature radius", "0", Patterns::Double(0.),
+                        "2D: radius rho of the outgoing wave fronts at the boundary (0: plane modes, the "
+                        "source); rho > 0: modes in polar coordinates about x_i - rho n with the "
+                        "cylindrical amplitude sqrt(rho/r) (e.g. a disk near field centred at the source).");
       prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge|pml"),
                         "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), "
                         "only the damping sponge (PD: nothing overwritten, energy-stable), or the "
@@ -143,6 +147,7 @@ namespace PeriDEAL
       lattice_mode_damping     = prm.get_double("Lattice mode damping");
       layer_filter             = prm.get_double("Layer filter");
       fit_form                 = prm.get("Fit form");
+      curvature_radius         = prm.get_double("Curvature radius");
       method                   = prm.get("Method");
       sponge_damping           = prm.get_double("Sponge damping");
       sponge_thickness         = prm.get_double("Sponge thickness");
@@ -351,6 +356,9 @@ namespace PeriDEAL
                       "0 < Delta k <= pi/dx = " + std::to_string(M_PI / dx) + " (4.83)");
       check_parameter(prm.cloud_radius > 0., "Absorbing boundary/Cloud radius", prm.cloud_radius,
                       "> 0");
+      check_parameter(prm.curvature_radius == 0. || prm.curvature_radius > prm.cloud_radius,
+                      "Absorbing boundary/Curvature radius", prm.curvature_radius,
+                      "0 or > the cloud radius " + std::to_string(prm.cloud_radius));
       absorbing = absorbing_in;
       cloud_start.assign(1, 0);
       cloud_index.clear();
@@ -470,9 +478,24 @@ namespace PeriDEAL
               m[dim + 2] = decay[c];
               node_modes[a].push_back(m);
             }
-          const auto mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int c) {
+          // Curved wave fronts (curvature_radius rho > 0, 2D): the local
+          // coordinates become s = (r - rho, rho theta) about the centre
+          // x_i - rho n, with the cylindrical amplitude sqrt(rho / r).
+          const double rho  = dim == 2 ? prm.curvature_radius : 0.;
+          const auto   mode = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int c) {
             const std::complex<double> I(0., 1.);
-            return std::exp(-decay[c] * time + I * (kvec[c] * xbar) - I * omega[c] * time);
+            Tensor<1, dim>             s         = xbar;
+            double                     amplitude = 1.;
+            if (rho > 0.)
+              {
+                Tensor<1, dim> from_centre = xbar;
+                from_centre[0] += rho;
+                const double radius = from_centre.norm();
+                s[0]                = radius - rho;
+                s[dim - 1]          = rho * std::atan2(from_centre[dim - 1], from_centre[0]);
+                amplitude           = std::sqrt(rho / radius);
+              }
+            return amplitude * std::exp(-decay[c] * time + I * (kvec[c] * s) - I * omega[c] * time);
           };
           const auto mode_rate = [&](const unsigned int c) {
             return -decay[c] - std::complex<double>(0., 1.) * omega[c];

@@ -3,6 +3,8 @@ foreach(_t constant_state spectral_radius bad_input backward_euler_guard)
   perideal_add_test(NAME fem_abc.${_t} COMMAND $<TARGET_FILE:fem_abc_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME fem_abc.e13 COMMAND $<TARGET_FILE:fem_abc_tests> e13 LABELS convergence)
+# E13 with curved modes (Curvature radius = 64, session 12).
+perideal_add_test(NAME fem_abc.e13_curved COMMAND $<TARGET_FILE:fem_abc_tests> e13_curved LABELS convergence)
 # Implicit Newmark (lumped, consistent mass): one-step spectral radius with the EBF constraints.
 perideal_add_test(NAME fem_abc.newmark_spectral_radius COMMAND $<TARGET_FILE:fem_abc_tests> newmark_spectral_radius LABELS unit)
 # E13 with Newmark + consistent mass (80 s: two KLU-factorized systems, 1600 steps).

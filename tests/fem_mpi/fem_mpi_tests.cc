@@ -19,9 +19,13 @@
 #include <perideal/fem/fem_wave.h>
 
 #include "../check.h"
+#include "../wave_settings.h"
 
 #include <cmath>
+#include <complex>
+#include <cstdlib>
 #include <ctime>
+#include <sstream>
 #include <array>
 #include <functional>
 
@@ -263,6 +267,10 @@ namespace
     fp.scheme      = "velocity Verlet";
     fp.lumped_mass = true;
     wave_case("disk Q1 lumped Verlet EBF", disk(4., 4), fp, Fem::WaveBoundary::absorbing, e13_abc("local"), 300);
+    Abc::WaveAbcParameters curved = e13_abc("local");
+    curved.curvature_radius       = 4.;
+    curved.n_directions           = 0;
+    wave_case("disk Q1 lumped Verlet EBF, curved modes", disk(4., 4), fp, Fem::WaveBoundary::absorbing, curved, 300);
   }
 
   // ------------------------------------------------------------------------
@@ -341,6 +349,10 @@ namespace
   struct DiskWaveResult
   {
     double e_ebf = 0., e_first = 0., p_ebf = 0., p_first = 0.;
+    /** Max |u - u_ref| over the near-field vertices at t = T. */
+    double f_ebf = 0., f_first = 0.;
+    /** Largest |E(t) - E_ref(t)|/E0 over the samples of the second half of the run (EBF). */
+    double late_ebf = 0.;
   };
 
   DiskWaveResult
@@ -385,13 +397,25 @@ namespace
             const double ur = ref.value_at(probe);
             r.p_ebf         = std::max(r.p_ebf, std::abs(ebf.value_at(probe) - ur));
             r.p_first       = std::max(r.p_first, std::abs(first.value_at(probe) - ur));
+            if (2 * s > n_steps)
+              r.late_ebf = std::max(r.late_ebf, std::abs(ebf.energy(inside) - er) / e0);
           }
       }
+    // Field error at t = T over the near-field vertices (the issue's measure).
+    for (const auto &cell : near.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        {
+          const Point<2> p  = cell->vertex(v);
+          const double   ur = ref.value_at(p);
+          r.f_ebf           = std::max(r.f_ebf, std::abs(ebf.value_at(p) - ur));
+          r.f_first         = std::max(r.f_first, std::abs(first.value_at(p) - ur));
+        }
     if (root())
       std::cout << "  disk R = " << R << ", t = " << T << ": max |E - E_ref|/E0 EBF " << sci(r.e_ebf)
                 << " first-order " << sci(r.e_first) << " (ratio " << r.e_first / r.e_ebf << "); probe EBF "
-                << sci(r.p_ebf) << " first-order " << sci(r.p_first) << " (ratio " << r.p_first / r.p_ebf << ")"
-                << std::endl;
+                << sci(r.p_ebf) << " first-order " << sci(r.p_first) << " (ratio " << r.p_first / r.p_ebf
+                << "); field at t = T EBF " << sci(r.f_ebf) << " first-order " << sci(r.f_first) << " (ratio "
+                << r.f_first / r.f_ebf << ")" << std::endl;
     return r;
   }
 
@@ -399,38 +423,129 @@ namespace
    * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
    * velocity Verlet, local dispersion) against the extended disk of radius
    * 18 (nothing reflected there is back before t = 16) and the first-order
-   * ABC on the same disk.
+   * ABC on the same disk. EBF with curved modes (Curvature radius = R,
+   * normal modes only; session 12).
    */
   void
   disk_wave()
   {
-    const double R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
-    const auto   r = run_disk_wave(disk(R, 5), disk(R_ref, 6), R, T, e13_abc("local"));
-    // NOT reproduced on the disk: measured EBF 1.36e-2 vs first-order
-    // 1.16e-2 (energy), probe 0.107 vs 0.043; the default clouds (d_inf =
-    // 2 h with h the largest minimum vertex distance, smaller than the
-    // 0.39 boundary spacing) have 2-3 points only, all behind along the
-    // normal. Session-6 scan (energy error, first-order 1.16e-2):
-    //   hyper_ball d_inf 0.8 / 1.0, cone 0.5: 0.44 / 1.18 (clouds 8-12 / 7-18);
-    //   cone 0.25: 3.9e5 / 8.5e15 (diverge);
-    //   hyper_ball_balanced (4 ref.), default / 0.8 / 1.0: 2.8e-2 / 6.0 / 2.3e4
-    //   (first-order 1.6e-2);
-    //   Newmark + consistent mass (stable on squares): 1.36e-2 / 0.45 / 1.20,
-    //   the same as Verlet: the time integrator and the lumping are not the
-    //   cause, the extrapolation on the curved boundary's clouds is.
-    // Session 7: the reference is not the cause (disk(18.5, 6) vs
-    // disk(18.5, 7): energy 1.8e-3, probe 2.9e-4; first-order vs the finer
-    // reference 1.17e-2 as before). One time level 1.54e-2, Delta phi
-    // 0.2 / 0.6 1.20e-2 / 1.37e-2, Delta k 0.5 / 2 1.25e-2 / 0.46, n_k 4
-    // 1.41e-2, n_phi 4 1.36e-2, cone 0.8 with d_inf 0.6 (5-6 points)
-    // 1.19e-2, pseudo-inverse cutoff 1e-3 1.55e-2: none below first order.
-    // Asserted is what was measured:
-    // the first-order ABC within 2e-2, the EBF run bounded (< 2e-2, probe
-    // < 0.15).
-    check(r.e_first < 2e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(r.e_first) + " < 2e-2");
-    check(r.e_ebf < 2e-2 && r.p_ebf < 0.15,
-          "disk EBF bounded: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 2e-2, probe " + sci(r.p_ebf) + " < 0.15");
+    const double           R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    Abc::WaveAbcParameters ap = e13_abc("local");
+    ap.curvature_radius       = R;
+    ap.n_directions           = 0;
+    const auto r = run_disk_wave(disk(R, 5), disk(R_ref, 6), R, T, ap);
+    // Plane modes (the source, Curvature radius 0) were NOT better than the
+    // first-order ABC here: energy 1.36e-2 vs 1.16e-2, probe 0.107 vs
+    // 0.043, field at T 0.112 vs 0.084; the default clouds (d_inf = 2 h)
+    // have 2-3 points, all behind along the normal. Scans of sessions 6/7
+    // and 12 (doc/design.md): d_inf, cone, Delta phi, Delta k, n_k, time
+    // levels, pseudo-inverse cutoff, fit form increment: 1.2e-2 .. 1.5e-2 or
+    // divergence. The plane modes miss the cylindrical spreading
+    // (amplitude ~ r^-1/2) of the low wave numbers (k R ~ 1 .. 8).
+    // Measured with the curved modes: energy 5.68e-3 vs 1.16e-2 (2.0x),
+    // probe 1.48e-2 vs 4.33e-2 (2.9x), field at t = T 2.08e-2 vs 8.45e-2
+    // (4.1x); the issue's 10x is NOT reached, and the gain is lost on the
+    // once-refined disk (refinement 6: 1.00e-2 vs 1.18e-2; doc/design.md,
+    // session 12). Tolerances ~20 % beyond the measured values.
+    check(r.e_first < 1.4e-2, "disk first-order ABC: max |E - E_ref|/E0 = " + sci(r.e_first) + " < 1.4e-2");
+    check(r.e_ebf < 7e-3 && 1.7 * r.e_ebf < r.e_first,
+          "disk EBF, curved modes: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 7e-3 and 1.7x below first order");
+    check(3.3 * r.f_ebf < r.f_first && 2.4 * r.p_ebf < r.p_first,
+          "disk EBF, curved modes: field at t = T " + sci(r.f_ebf) + " 3.3x and probe " + sci(r.p_ebf) +
+            " 2.4x below first order (" + sci(r.f_first) + ", " + sci(r.p_first) + ")");
+    // Stability: the one-step map on disk(2, 3) (the same boundary spacing)
+    // has radius 1 (the kept constant; measured 1 + 0, disk(4, 4) 1 + 5e-14).
+    Abc::WaveAbcParameters small = ap;
+    small.curvature_radius       = 2.;
+    Triangulation<2> tria;
+    disk(2., 3)(tria);
+    Fem::FemWaveParameters fp;
+    fp.damping   = 0.0125;
+    fp.time_step = 0.02;
+    const ScalarFunctionFromFunctionObject<2> u0(pulse);
+    Fem::FemWave<2>                           w(tria, fp, Fem::WaveBoundary::absorbing, small, u0);
+    unsigned int                              n_up = 0;
+    const double                              rho  = w.one_step_spectral_radius(4000, &n_up);
+    if (root())
+      std::cout << "  disk(2, 3), curved modes: one-step spectral radius 1 + " << sci(rho - 1.) << std::endl;
+    check(rho <= 1. + 1e-10, "disk EBF, curved modes: one-step spectral radius " + sci(rho - 1.) + " above 1 <= 1e-10");
   }
+
+  // Exploratory (not registered): FEM_DISK_SCAN="key=value ...; ..." runs
+  // of disk_wave with the EBF keys of with_wave_settings (on e13_abc
+  // ("local")), plus R, T, ref (refinements of the reference disk),
+  // newmark=1, level (near refinement at R = 8), cloudh (d_inf / h), and
+  // rho=R0 (one-step spectral radius on disk(R0, 3 + log2(R0/2)), the
+  // boundary spacing of the disk_wave mesh) or rhoonly=1 (no run).
+  void
+  disk_wave_scan()
+  {
+    const char        *env = std::getenv("FEM_DISK_SCAN");
+    std::istringstream runs(env ? env : "");
+    std::string        run;
+    while (std::getline(runs, run, ';'))
+      {
+        const auto kv = key_values(run);
+        const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv.at(k)) : def; };
+        Abc::WaveAbcParameters ap = with_wave_settings(e13_abc("local"), kv);
+        if (root())
+          std::cout << "[" << run << "]" << std::endl;
+        try
+          {
+            if (kv.count("rho"))
+              {
+                const double     R0 = num("rho", 2.);
+                Triangulation<2> tria;
+                disk(R0, 3 + static_cast<unsigned int>(std::round(std::log2(R0 / 2.))))(tria);
+                Fem::FemWaveParameters fp;
+                fp.damping   = 0.0125;
+                fp.time_step = num("dt", 0.02);
+                if (kv.count("newmark"))
+                  {
+                    fp.scheme      = "Newmark";
+                    fp.lumped_mass = false;
+                  }
+                const ScalarFunctionFromFunctionObject<2> u0(pulse);
+                Fem::FemWave<2>      w(tria, fp, Fem::WaveBoundary::absorbing, ap, u0);
+                unsigned int         n_up = 0;
+                std::complex<double> dom;
+                const double         rho = w.one_step_spectral_radius(8000, &n_up, &dom);
+                const auto          &st  = w.absorbing_boundary().statistics();
+                std::cout << "  rho - 1 = " << sci(rho - 1.) << " (" << n_up << " up, dominant " << dom
+                          << "), clouds " << st.min_cloud_size << ".." << st.max_cloud_size << ", max|V| "
+                          << sci(st.max_update_norm) << std::endl;
+              }
+            if (!kv.count("rhoonly"))
+              {
+                const double R = num("R", 8.), T = num("T", 16.), R_ref = 0.5 * (T + R + 6.) + 3.;
+                // The boundary spacing of disk(8, 5) (0.39) for every R.
+                const unsigned int level =
+                  static_cast<unsigned int>(num("level", 5)) + static_cast<unsigned int>(std::round(std::log2(R / 8.)));
+                if (kv.count("cloudh"))
+                  {
+                    // d_inf = cloudh * h, h as in FemWave (largest minimum vertex distance).
+                    Triangulation<2> t;
+                    disk(R, level)(t);
+                    double h = 0.;
+                    for (const auto &cell : t.active_cell_iterators())
+                      h = std::max(h, cell->minimum_vertex_distance());
+                    ap.cloud_radius = num("cloudh", 2.) * h * (1. + 1e-9);
+                    if (root())
+                      std::cout << "  h = " << h << ", d_inf = " << ap.cloud_radius << std::endl;
+                  }
+                const auto r = run_disk_wave(disk(R, level), disk(R_ref, static_cast<unsigned int>(num("ref", level + 1))),
+                                             R, T, ap, kv.count("newmark") > 0);
+                if (root())
+                  std::cout << "  late energy error EBF " << sci(r.late_ebf) << std::endl;
+              }
+          }
+        catch (std::exception &e)
+          {
+            std::cout << "  exception: " << e.what() << std::endl;
+          }
+      }
+  }
+
   /** 3D heat kernel of C0 = exp(-4 |x|^2), D = 1. */
   class HeatKernel3d : public Function<3>
   {
@@ -686,5 +801,6 @@ main(int argc, char **argv)
   return run(argc, argv,
              {{"rank_invariance_diffusion", rank_invariance_diffusion},
               {"disk_diffusion", disk_diffusion},
-              {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave}});
+              {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave},
+              {"disk_wave_scan", disk_wave_scan}});
 }

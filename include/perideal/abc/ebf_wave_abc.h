@@ -122,6 +122,17 @@ namespace PeriDEAL
        */
       std::string fit_form = "value";
       /**
+       * 2D: radius rho of the wave fronts at the boundary for the mode set
+       * (0: plane modes, the source). With rho > 0 every mode is evaluated in
+       * the polar coordinates about x_i - rho n, s = (r - rho, rho theta),
+       * with the cylindrical amplitude sqrt(rho / r): the normal modes
+       * become outgoing cylindrical waves (WKB), which a plane-wave fit over
+       * a cloud of a curved boundary cannot represent when k rho is small
+       * (FEM disks, doc/design.md, session 12). Typically the radius of a
+       * disk near field centred at the source.
+       */
+      double curvature_radius = 0.;
+      /**
        * "ebf" (the EBF extrapolation (4.82)) or "first order": the
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone

@@ -84,7 +84,11 @@ namespace PeriDEAL
      * the boundary DoFs as time-dependent Dirichlet data), first-order
      * absorbing (Robin term chi int_Gamma (u_t + d u) w, lumped), or
      * homogeneous Dirichlet. Cloud DoFs of other ranks are ghosts, so the
-     * result does not depend on the number of ranks.
+     * result does not depend on the number of ranks. On curved boundaries
+     * (disks centred at the source) use curved modes,
+     * Abc::WaveAbcParameters::curvature_radius = R with n_directions = 0:
+     * plane modes are no better than the first-order ABC there
+     * (doc/design.md, session 12).
      */
     template <int dim>
     class FemWave
