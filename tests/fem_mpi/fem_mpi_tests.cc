@@ -25,7 +25,9 @@
 #include <array>
 #include <cstdlib>
 #include <functional>
+#include <iomanip>
 #include <map>
+#include <memory>
 
 using namespace dealii;
 using namespace PeriDEAL;
@@ -487,9 +489,13 @@ namespace
   diffusion_3d(const bool ball, const double L, const unsigned int refinements, const double t_end,
                const double dt, const double cloud_radius, const std::string &fit = "least squares",
                const std::string &imposed = "value",
-               const std::function<void(Abc::EbfParameters &)> &tweak = {})
+               const std::function<void(Abc::EbfParameters &)> &tweak = {}, const bool distributed = false)
   {
-    Triangulation<3> tria;
+    // (distributed: a parallel::distributed mesh over MPI_COMM_WORLD.)
+    std::unique_ptr<Triangulation<3>> tria_ptr =
+      distributed ? std::make_unique<parallel::distributed::Triangulation<3>>(MPI_COMM_WORLD) :
+                    std::make_unique<Triangulation<3>>();
+    Triangulation<3> &tria = *tria_ptr;
     if (ball)
       GridGenerator::hyper_ball(tria, Point<3>(), L);
     else
@@ -756,7 +762,7 @@ namespace
     std::map<std::string, std::string> kv{{"shape", "ball"}, {"fit", "least squares"}, {"form", "value"},
                                           {"rcond", "0"}, {"dinf", "0.45"}, {"dk", "0"}, {"nk", "20"},
                                           {"nphi", "5"}, {"dt", "1e-3"}, {"imposed", "value"}, {"ref", "3"},
-                                          {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}};
+                                          {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"}};
     std::string spec = env ? env : "";
     for (std::size_t pos = 0; pos < spec.size();)
       {
@@ -825,10 +831,11 @@ namespace
           {
             const bool ball = kv["shape"] == "ball";
             const auto r = diffusion_3d(ball, 1.5, std::stoi(kv["ref"]), std::stod(kv["t"]), std::stod(kv["dt"]),
-                                        std::stod(kv["dinf"]), kv["fit"], kv["imposed"], tweak);
+                                        std::stod(kv["dinf"]), kv["fit"], kv["imposed"], tweak,
+                                        kv["distributed"] == "1");
             if (root())
-              std::cout << "  RESULT ratio " << r[2] / r[1] << " end " << sci(r[1]) << " max " << sci(r[0])
-                        << std::endl;
+              std::cout << "  RESULT ratio " << r[2] / r[1] << " end " << std::setprecision(13) << r[1] << " max "
+                        << r[0] << std::setprecision(6) << std::endl;
           }
       }
     catch (const ParameterError &e)
