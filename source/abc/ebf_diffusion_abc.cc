@@ -496,7 +496,9 @@ namespace PeriDEAL
                 M(j, n_modes - 1) = 1.;
             }
           const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
-          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
+          // (The singular vectors only for a cut pseudo-inverse.)
+          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(
+            M, prm.pseudo_inverse_tolerance > 0. ? Eigen::ComputeThinU | Eigen::ComputeThinV : 0);
           const auto                              &sv = svd.singularValues();
           // The retained singular values: all of the decomposition's rank,
           // or those above the tolerance times the largest.
