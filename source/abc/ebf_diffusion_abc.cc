@@ -183,13 +183,25 @@ namespace PeriDEAL
                         "bounded fit: V_j >= -this (negative: no bound).");
       prm.declare_entry("Maximum stabilization rounds", "60", Patterns::Integer(1, 1000),
                         "stabilized fit: rounds of power iteration and blending.");
-      prm.declare_entry("Imposed", "value", Patterns::Selection("value|normal derivative"),
+      prm.declare_entry("Imposed", "value", Patterns::Selection("value|normal derivative|half derivative"),
                         "value: the absorbing value at t^{n+1} as a Dirichlet value (4.31); normal "
                         "derivative (FEM, explicit lumped): the fitted outward derivative at t^n as a "
-                        "Neumann flux.");
+                        "Neumann flux; half derivative (FEM, explicit lumped): the flux dC/dn = "
+                        "-(curvature/2) C - D^{-1/2} d^{1/2}C/dt^{1/2} of the boundary DoF's history "
+                        "(no clouds).");
+      prm.declare_entry("Boundary curvature", "0", Patterns::Double(0.),
+                        "Imposed = half derivative: sum of the principal curvatures of the truncation "
+                        "boundary (2/R for a sphere, 1/R for a circle, 0 for flat faces).");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
+      prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
+                        "least squares / stabilized fit: relative singular-value cutoff of M^+ "
+                        "(0: the rank threshold of Eigen's complete orthogonal decomposition).");
+      prm.declare_entry("Fit form", "value", Patterns::Selection("value|increment"),
+                        "value (4.31): V = Psi(0, dt) M^+; increment (least squares or stabilized "
+                        "fit, Imposed = value): V = e_i + (Psi(0, dt) - Psi(0, 0)) M^+, the old value "
+                        "plus the extrapolated change.");
       prm.declare_entry("Stability check steps", "200", Patterns::Integer(0),
                         "PD near field: power iteration of the one-step map over this many steps "
                         "at setup; growth stops the setup naming the cloud (0: off).");
@@ -213,13 +225,14 @@ namespace PeriDEAL
       lower_bound           = prm.get_double("Updating vector lower bound");
       max_stabilization_rounds = prm.get_integer("Maximum stabilization rounds");
       imposed                  = prm.get("Imposed");
+      pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
+      fit_form                 = prm.get("Fit form");
+      boundary_curvature       = prm.get_double("Boundary curvature");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
       check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
                         fit == "stabilized",
                       "Absorbing boundary/Updating vector fit", fit,
                       "least squares, monotone, bounded or stabilized");
-      check_parameter(imposed == "value" || fit != "bounded", "Absorbing boundary/Updating vector fit", fit,
-                      "least squares, monotone or stabilized with Imposed = normal derivative");
       check_parameter(l1_excess >= 0., "Absorbing boundary/Updating vector l1 excess", l1_excess, ">= 0");
     }
 
@@ -396,9 +409,20 @@ namespace PeriDEAL
       // The normal derivative adds the constant mode (derivative 0) so that
       // a constant field gives no flux.
       const bool         flux    = prm.imposed == "normal derivative";
+      // The combinations of the settings are checked here only (reinit is
+      // what every caller, parsed or not, goes through).
+      check_parameter(prm.imposed == "value" || prm.imposed == "normal derivative", "Absorbing boundary/Imposed",
+                      prm.imposed, "value or normal derivative for the cloud fit (half derivative uses no clouds)");
       check_parameter(prm.imposed == "value" || (flux && prm.fit != "bounded"), "Absorbing boundary/Imposed",
                       prm.imposed + " with the " + prm.fit + " fit",
                       "value, or normal derivative with the least squares, monotone or stabilized fit");
+      const bool increment = prm.fit_form == "increment";
+      check_parameter(prm.fit_form == "value" ||
+                        (increment && !flux && (prm.fit == "least squares" || prm.fit == "stabilized")),
+                      "Absorbing boundary/Fit form", prm.fit_form + " with the " + prm.fit + " fit and Imposed = " + prm.imposed,
+                      "value, or increment with the least squares or stabilized fit and Imposed = value");
+      check_parameter(prm.pseudo_inverse_tolerance >= 0. && prm.pseudo_inverse_tolerance < 1.,
+                      "Absorbing boundary/Pseudo-inverse tolerance", prm.pseudo_inverse_tolerance, "in [0, 1)");
       const unsigned int n_modes = dirs.size() * k.size() + (flux ? 1 : 0);
       Eigen::RowVectorXd psi_dt(n_modes);
       Tensor<1, dim>     e; // R n: the outward normal in the local frame
@@ -472,6 +496,27 @@ namespace PeriDEAL
                 M(j, n_modes - 1) = 1.;
             }
           const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
+          // (The singular vectors only for a cut pseudo-inverse.)
+          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(
+            M, prm.pseudo_inverse_tolerance > 0. ? Eigen::ComputeThinU | Eigen::ComputeThinV : 0);
+          const auto                              &sv = svd.singularValues();
+          // The retained singular values: all of the decomposition's rank,
+          // or those above the tolerance times the largest.
+          unsigned int rank = cod.rank();
+          if (prm.pseudo_inverse_tolerance > 0.)
+            {
+              rank = 0;
+              while (rank < sv.size() && sv[rank] > prm.pseudo_inverse_tolerance * sv[0])
+                ++rank;
+            }
+          // psi M^+ over the retained singular directions.
+          const auto fit_ls = [&](const Eigen::RowVectorXd &psi) -> Eigen::RowVectorXd {
+            if (prm.pseudo_inverse_tolerance == 0.)
+              return psi * cod.pseudoInverse();
+            const Eigen::RowVectorXd c =
+              (psi * svd.matrixV().leftCols(rank)).cwiseQuotient(sv.head(rank).transpose());
+            return c * svd.matrixU().leftCols(rank).transpose();
+          };
           // Least squares (4.31), or (monotone) V_j >= 0, sum V_j = 1: the
           // equality by a heavily weighted extra row (the weighting method
           // for equality constraints), then normalized exactly.
@@ -479,8 +524,14 @@ namespace PeriDEAL
           const bool         monotone = prm.fit == "monotone";
           if (flux && monotone)
             V = monotone_flux_fit(M, psi_dt);
+          else if (increment)
+            {
+              // V = e_0 + (Psi(0, dt) - Psi(0, 0)) M^+; Psi(0, 0) is row 0 of M.
+              V = fit_ls(psi_dt - M.row(0));
+              V[0] += 1.;
+            }
           else if (prm.fit == "least squares" || prm.fit == "stabilized")
-            V = psi_dt * cod.pseudoInverse();
+            V = fit_ls(psi_dt);
           else if (monotone)
             V = bounded_fit(M, psi_dt, 0., -1.);
           else
@@ -500,9 +551,6 @@ namespace PeriDEAL
             }
 
           // Condition number over the retained singular values.
-          const Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
-          const auto                              &sv   = svd.singularValues();
-          const unsigned int                       rank = cod.rank();
           const double cond = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
           const double vmax = V.cwiseAbs().maxCoeff();
           const double vl1  = V.cwiseAbs().sum();

@@ -11,6 +11,8 @@
 #include <perideal/fem/fem_diffusion.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -57,9 +59,11 @@ namespace PeriDEAL
       // Absorbing nodes: the owned boundary DoFs, local frames from their
       // outward normals; clouds from every available point (ghosts included).
       std::vector<unsigned int> absorbing_dofs;
+      half_derivative = absorbing && abc_parameters.imposed == "half derivative";
       if (absorbing)
+        absorbing_dofs = near_field.boundary;
+      if (absorbing && !half_derivative)
         {
-          absorbing_dofs = near_field.boundary;
           abc.reinit(near_field.points, near_field.ids, absorbing_dofs, near_field.normals,
                      Abc::DiffusionDispersion::local(prm.diffusivity), prm.time_step,
                      abc_parameters, near_field.comm);
@@ -67,15 +71,51 @@ namespace PeriDEAL
       else
         abc = Abc::EbfDiffusionAbc<dim>();
 
-      const bool flux = absorbing && abc_parameters.imposed == "normal derivative";
+      const bool flux = absorbing && abc_parameters.imposed != "value";
       check_parameter(!flux || (prm.scheme == "forward Euler" && prm.lumped_mass), "FEM/Scheme",
-                      prm.scheme, "forward Euler with lumped mass for Imposed = normal derivative");
+                      prm.scheme, "forward Euler with lumped mass for Imposed = " + abc_parameters.imposed);
       flux_weight.reinit(part);
       flux_boundary = flux;
       if (flux)
         for (const unsigned int l : absorbing_dofs)
           flux_weight.local_element(l) = prm.diffusivity * boundary_lumped.local_element(l) /
                                          lumped.local_element(l);
+      half_dofs.clear();
+      half_history.clear();
+      n_history_levels = 0;
+      if (half_derivative)
+        {
+          check_parameter(abc_parameters.boundary_curvature >= 0., "Absorbing boundary/Boundary curvature",
+                          abc_parameters.boundary_curvature, ">= 0");
+          half_dofs      = absorbing_dofs;
+          half_curvature = abc_parameters.boundary_curvature;
+          // Stability: the half derivative at t^{n+1} (Gruenwald-Letnikov,
+          // weights g_0 = 1, g_j < 0 for j >= 1) and the curvature term are
+          // taken at the boundary DoF's new value (local, no solve):
+          // (1 + beta) C_i^{n+1} = [C^n - dt M^-1 K C^n]_i - w sqrt(dt/D)
+          // sum_{j >= 1} g_j C_i^{n+1-j}, beta = w sqrt(dt/D) + dt w kappa/2,
+          // w = D |Gamma_i| / m_i. The history enters with -g_j >= 0, the row
+          // sum is (1 + w sqrt(dt/D) (1 - sum_{j <= n+1} g_j)) / (1 + beta)
+          // <= 1 (the partial sums of g are positive): the ABC adds only
+          // nonnegative weights and lowers the row sum, so wherever the
+          // forward Euler map with natural boundary is nonnegative (K_ij <= 0,
+          // dt <= m_i / K_ii) max |C| over the run cannot grow, provided the
+          // C_i^n coefficient 1 - dt K_ii/m_i + w sqrt(dt/D)/2 is >= 0 (so the
+          // bound checked here is the weakest such). With x = sqrt(dt):
+          // a x^2 - b x / 2 <= 1, a = K_ii / m_i, b = w / sqrt(D).
+          double dt_max = std::numeric_limits<double>::max();
+          for (const unsigned int l : half_dofs)
+            {
+              const double a = stiffness.diag_element(near_field.ids[l]) / lumped.local_element(l);
+              const double b = flux_weight.local_element(l) / std::sqrt(prm.diffusivity);
+              const double x = (0.5 * b + std::sqrt(0.25 * b * b + 4. * a)) / (2. * a);
+              dt_max         = std::min(dt_max, x * x);
+            }
+          dt_max = Utilities::MPI::min(dt_max, near_field.comm);
+          check_parameter(prm.time_step <= dt_max, "FEM/Time step", prm.time_step,
+                          "<= " + std::to_string(dt_max) +
+                            " (Imposed = half derivative: the boundary rows stay nonnegative)");
+        }
 
       // System matrix: M (consistent explicit) or M + dt K (implicit), with
       // identity rows for the absorbing DoFs (their values are given).
@@ -158,7 +198,9 @@ namespace PeriDEAL
       // in 1D (never above 1 for a stable map in the tests), so the
       // threshold is 1 + 1e-5 per step (a doubling in 7e4 steps).
       stability_growth = 0.;
-      if (absorbing && abc_parameters.stability_check_steps > 0)
+      // (Imposed = half derivative: the map has memory, and its stability
+      // is the nonnegativity checked above.)
+      if (absorbing && !half_derivative && abc_parameters.stability_check_steps > 0)
         {
           const unsigned int n_check = abc_parameters.stability_check_steps;
           stability_growth           = arnoldi_spectral_radius(n_check / 4, n_krylov);
@@ -209,9 +251,12 @@ namespace PeriDEAL
     {
       using clock      = std::chrono::steady_clock;
       const auto start = clock::now();
-      abc.compute(C.begin(), boundary_values);
+      if (half_derivative)
+        half_derivative_flux();
+      else
+        abc.compute(C.begin(), boundary_values);
       const auto    abc_end   = clock::now();
-      const auto   &absorbing = abc.absorbing_points();
+      const auto   &absorbing = half_derivative ? half_dofs : abc.absorbing_points();
       const double  dt        = prm.time_step;
       const unsigned int n    = near_field.n_owned();
       if (prm.scheme == "forward Euler")
@@ -239,6 +284,19 @@ namespace PeriDEAL
           C.zero_out_ghost_values();
           solver->solve(C, rhs);
         }
+      else if (half_derivative)
+        {
+          // The flux at the new value (see setup): boundary_values holds the
+          // history part sum_{j >= 1} g_j C_i^{n+1-j}.
+          const double root_dt = std::sqrt(dt / prm.diffusivity);
+          for (unsigned int a = 0; a < absorbing.size(); ++a)
+            {
+              const unsigned int l = absorbing[a];
+              const double       w = flux_weight.local_element(l);
+              C.local_element(l)   = (C.local_element(l) - w * root_dt * boundary_values[a]) /
+                                   (1. + w * root_dt + 0.5 * dt * w * half_curvature);
+            }
+        }
       else if (flux_boundary)
         // The EBF normal derivative as the flux of the boundary DoF's row.
         for (unsigned int a = 0; a < absorbing.size(); ++a)
@@ -255,6 +313,33 @@ namespace PeriDEAL
     }
 
     template <int dim>
+    void
+    FemDiffusion<dim>::half_derivative_flux()
+    {
+      // The history part of the Gruenwald-Letnikov half derivative at
+      // t^{n+1}, dt^{-1/2} sum_{j=0}^{n+1} g_j C^{n+1-j}, g_0 = 1, g_j =
+      // g_{j-1} (j - 3/2) / j (Riemann-Liouville, first order in dt): the
+      // sum over j >= 1 (levels n .. 0); the j = 0 term is taken implicitly
+      // in advance(). The whole history is summed: O(n) per step and DoF.
+      const unsigned int nb = half_dofs.size();
+      for (const unsigned int l : half_dofs)
+        half_history.push_back(C.local_element(l));
+      const unsigned int n = n_history_levels++;
+      while (gl_weights.size() <= n + 1)
+        {
+          const double j = gl_weights.size();
+          gl_weights.push_back(j == 0 ? 1. : gl_weights.back() * (j - 1.5) / j);
+        }
+      boundary_values.assign(nb, 0.);
+      for (unsigned int j = 1; j <= n + 1; ++j)
+        {
+          const double *level = half_history.data() + std::size_t(n + 1 - j) * nb;
+          for (unsigned int a = 0; a < nb; ++a)
+            boundary_values[a] += gl_weights[j] * level[a];
+        }
+    }
+
+    template <int dim>
     double
     FemDiffusion<dim>::power_iteration_growth(const unsigned int n_steps)
     {
@@ -268,6 +353,8 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::power_iterate(const unsigned int n_steps)
     {
+      check_parameter(!half_derivative, "Absorbing boundary/Imposed", "half derivative",
+                      "value or normal derivative for the one-step map checks (the half derivative has memory)");
       random_cloud_start();
       double             log_growth = 0.;
       const unsigned int window     = std::max(1u, n_steps / 4);
@@ -308,6 +395,8 @@ namespace PeriDEAL
     double
     FemDiffusion<dim>::arnoldi_spectral_radius(const unsigned int n_warm, const unsigned int n_krylov)
     {
+      check_parameter(!half_derivative, "Absorbing boundary/Imposed", "half derivative",
+                      "value or normal derivative for the one-step map checks (the half derivative has memory)");
       const SavedState saved = save_state();
       random_cloud_start();
       for (unsigned int n = 0; n < n_warm; ++n)

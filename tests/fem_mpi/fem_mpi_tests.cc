@@ -28,6 +28,9 @@
 #include <sstream>
 #include <array>
 #include <functional>
+#include <iomanip>
+#include <map>
+#include <memory>
 
 using namespace dealii;
 using namespace PeriDEAL;
@@ -103,12 +106,13 @@ namespace
   void
   diffusion_case(const std::string &name, const MeshMaker &mesh, const Fem::FemDiffusionParameters &fp,
                  const double cloud_radius, const unsigned int n_steps, const std::string &imposed = "value",
-                 const std::string &fit = "least squares")
+                 const std::string &fit = "least squares", const double curvature = 0.)
   {
     Abc::EbfParameters ap;
-    ap.cloud_radius = cloud_radius;
-    ap.imposed      = imposed;
-    ap.fit          = fit;
+    ap.cloud_radius       = cloud_radius;
+    ap.imposed            = imposed;
+    ap.fit                = fit;
+    ap.boundary_curvature = curvature;
     HeatKernel                                c0;
     parallel::distributed::Triangulation<2> ptria(MPI_COMM_WORLD);
     Triangulation<2>                          stria;
@@ -140,7 +144,7 @@ namespace
                 << ser.absorbing_boundary().statistics().n_blended << ")" << std::endl;
     check(par.absorbing_boundary().statistics().n_blended == ser.absorbing_boundary().statistics().n_blended,
           name + ": the same number of clouds blended as serially");
-    if (Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) > 1)
+    if (Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) > 1 && imposed != "half derivative")
       check(n_straddle > 0, name + ": some clouds straddle the rank boundary (" + std::to_string(n_straddle) + ")");
     // Round-off: a few hundred steps of 1e-16 perturbations of a stable map.
     check(diff <= 1e-12 * scale, name + ": distributed = serial DoF by DoF, max diff " + sci(diff));
@@ -237,6 +241,9 @@ namespace
                    "normal derivative", "monotone");
     diffusion_case("disk Q1 lumped forward Euler, normal derivative stabilized", disk(2., 4), fp, 0.3, 200,
                    "normal derivative", "stabilized");
+    // Session 12: the half-derivative flux (per boundary DoF, no clouds).
+    diffusion_case("disk Q1 lumped forward Euler, half derivative", disk(2., 4), fp, 0.3, 200, "half derivative",
+                   "least squares", 0.5);
   }
 
   Abc::WaveAbcParameters
@@ -283,13 +290,17 @@ namespace
    * s = 1 + 16 t (closed form over the disk) and the max pointwise error;
    * the same disk with Neumann truncation as the baseline.
    */
-  void
-  disk_diffusion()
+  /**
+   * Energy errors (max over the run, at t_end; Neumann at t_end) and the
+   * max pointwise error at t_end of the disk run of disk_diffusion() with
+   * @p ap (d_inf = 0.2 set here).
+   */
+  std::array<double, 4>
+  run_disk_diffusion(Abc::EbfParameters ap)
   {
     const double       R = 3., t_end = 3.;
     Fem::FemDiffusionParameters fp;
     fp.time_step = 5e-4;
-    Abc::EbfParameters ap;
     // Boundary DoF spacing 2 pi R / 128 = 0.147. Measured: d_inf = 0.25 and
     // 0.3 violate the |V| guard at the ball's coarse corners; the monotone
     // fit is stable there but only 1.3-1.5x better than Neumann.
@@ -302,9 +313,9 @@ namespace
     neumann.setup(Abc::TruncationBoundary::neumann, ap, c0);
     const auto &st = ebf.absorbing_boundary().statistics();
     if (root())
-      std::cout << "  disk: " << st.n_absorbing << " absorbing DoFs, clouds " << st.min_cloud_size << ".."
-                << st.max_cloud_size << ", cond " << sci(st.max_condition_number) << ", max |V| "
-                << sci(st.max_update_norm) << std::endl;
+      std::cout << "  disk, Imposed = " << ap.imposed << ": " << st.n_absorbing << " absorbing DoFs, clouds "
+                << st.min_cloud_size << ".." << st.max_cloud_size << ", cond " << sci(st.max_condition_number)
+                << ", max |V| " << sci(st.max_update_norm) << std::endl;
     const BoundingBox<2> all(std::make_pair(Point<2>(-R, -R), Point<2>(R, R)));
     const auto exact_energy = [R](const double t) {
       const double s = 1. + 16. * t;
@@ -313,15 +324,10 @@ namespace
     const double       e0 = exact_energy(0.);
     double             max_ebf = 0., max_neumann = 0., end_ebf = 0., end_neumann = 0.;
     const unsigned int n_steps = static_cast<unsigned int>(std::round(t_end / fp.time_step));
-    // Stability in energy: the largest rise of the EBF run's Pi over one step.
-    double max_rise = -std::numeric_limits<double>::max(), pi_prev = ebf.energy(all);
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
         ebf.advance();
         neumann.advance();
-        const double pi = ebf.energy(all);
-        max_rise        = std::max(max_rise, (pi - pi_prev) / e0);
-        pi_prev         = pi;
         if (s % 100 == 0)
           {
             const double ee = exact_energy(ebf.time());
@@ -337,12 +343,38 @@ namespace
       std::cout << "  disk R = 3, t = 3: |Pi - Pi_exact|/Pi0 EBF max " << sci(max_ebf) << " end " << sci(end_ebf)
                 << ", Neumann end " << sci(end_neumann) << " (ratio " << end_neumann / end_ebf
                 << "); max |C - heat kernel| EBF " << sci(err_ebf) << " Neumann " << sci(err_neumann) << std::endl;
+    return {{max_ebf, end_ebf, end_neumann, err_ebf}};
+  }
+
+  /**
+   * Diffusion of C0 = exp(-4 |x|^2) in the disk of radius 3 to t = 3 against
+   * the heat kernel: energy Pi(t) = pi / (8 s) (1 - exp(-8 R^2 / s)),
+   * s = 1 + 16 t (closed form over the disk) and the max pointwise error;
+   * the same disk with Neumann truncation as the baseline.
+   */
+  void
+  disk_diffusion()
+  {
+    const auto r = run_disk_diffusion(Abc::EbfParameters());
     // Measured: energy 2.0e-3 (Neumann 4.0e-2, 20x), max error 2.5e-3
     // (Neumann 1.75e-2; the polygonal disk and h ~ 0.1 set the floor).
     // Tolerances ~50 % above the measured values; the 10x is the issue's.
-    check(max_ebf < 3e-3, "disk EBF: max |Pi - Pi_exact|/Pi0 = " + sci(max_ebf) + " < 3e-3");
-    check(end_neumann > 10. * end_ebf, "disk EBF at least 10x closer to the heat-kernel energy than Neumann at t_end");
-    check(err_ebf < 4e-3, "disk EBF: max |C - heat kernel| = " + sci(err_ebf) + " < 4e-3");
+    check(r[0] < 3e-3, "disk EBF: max |Pi - Pi_exact|/Pi0 = " + sci(r[0]) + " < 3e-3");
+    check(r[2] > 10. * r[1], "disk EBF at least 10x closer to the heat-kernel energy than Neumann at t_end");
+    check(r[3] < 4e-3, "disk EBF: max |C - heat kernel| = " + sci(r[3]) + " < 4e-3");
+    // Session 12: the half-derivative flux with the circle's curvature
+    // 1/R. Measured: end 1.4e-4 (284x), max over the run 1.1e-3, max |C -
+    // heat kernel| 1.1e-4 (Neumann 1.75e-2); with curvature 0 (the planar
+    // relation) 2.0e-3 (19.6x). Tolerances ~50 % above the measured values.
+    Abc::EbfParameters half;
+    half.imposed            = "half derivative";
+    half.boundary_curvature = 1. / 3.;
+    const auto h = run_disk_diffusion(half);
+    check(h[2] >= 10. * h[1] && h[1] < 2.1e-4,
+          "disk, half derivative: end " + sci(h[1]) + " < 2.1e-4, at least 10x closer than Neumann (" +
+            std::to_string(h[2] / h[1]) + "x)");
+    check(h[0] < 1.7e-3 && h[3] < 1.7e-4, "disk, half derivative: max |Pi - Pi_exact|/Pi0 = " + sci(h[0]) +
+                                             " < 1.7e-3, max |C - heat kernel| = " + sci(h[3]) + " < 1.7e-4");
   }
 
   /** Max energy and probe differences of the EBF and first-order runs on a disk near field. */
@@ -570,9 +602,14 @@ namespace
   std::array<double, 9>
   diffusion_3d(const bool ball, const double L, const unsigned int refinements, const double t_end,
                const double dt, const double cloud_radius, const std::string &fit = "least squares",
-               const std::string &imposed = "value")
+               const std::string &imposed = "value",
+               const std::function<void(Abc::EbfParameters &)> &tweak = {}, const bool distributed = false)
   {
-    Triangulation<3> tria;
+    // (distributed: a parallel::distributed mesh over MPI_COMM_WORLD.)
+    std::unique_ptr<Triangulation<3>> tria_ptr =
+      distributed ? std::make_unique<parallel::distributed::Triangulation<3>>(MPI_COMM_WORLD) :
+                    std::make_unique<Triangulation<3>>();
+    Triangulation<3> &tria = *tria_ptr;
     if (ball)
       GridGenerator::hyper_ball(tria, Point<3>(), L);
     else
@@ -591,6 +628,8 @@ namespace
         ap.max_update_l1   = 1.5;
         ap.max_update_norm = 1e10;
       }
+    if (tweak)
+      tweak(ap);
     HeatKernel3d         c0;
     Fem::FemDiffusion<3> ebf(tria, fp), neumann(tria, fp);
     const std::clock_t setup_start = std::clock();
@@ -686,7 +725,8 @@ namespace
                 << sci(max_ebf) << " end " << sci(end_ebf) << ", Neumann end " << sci(end_neumann) << " (ratio "
                 << end_neumann / end_ebf << "); max |C - heat kernel| EBF " << sci(err)
                 << ", largest one-step rise of Pi/Pi0 " << sci(max_rise) << std::endl;
-    const double power_growth = ebf.power_iteration_growth(400);
+    // (The half derivative's map has memory: no one-step checks.)
+    const double power_growth = imposed == "half derivative" ? 0. : ebf.power_iteration_growth(400);
     if (root())
       std::cout << "  " << (ball ? "ball" : "cube") << ": one-step growth power iteration (400 steps) "
                 << power_growth << ", Arnoldi (setup) " << ebf.stability_growth << std::endl;
@@ -792,6 +832,131 @@ namespace
             std::to_string(cube_flux[2] / cube_flux[1]) + "x), max " + sci(cube_flux[0]) + " < 8e-3");
     check(cube_flux[6] <= 0. && cube_flux[7] <= 1. && cube_flux[8] <= 1.,
           "cube, EBF normal derivative: Pi non-increasing every step, one-step growth <= 1");
+
+    // Session 12: Imposed = half derivative, dC/dn = -(kappa/2) C -
+    // D^{-1/2} d^{1/2}C/dt^{1/2} of the boundary DoF's history (kappa: sum
+    // of the principal curvatures, 2/R on the sphere; exact for the
+    // outgoing 3D monopole). The rate of the Robin sink now follows the
+    // field (the normal derivative's q = 1.871 is the modes' mean |k|).
+    // Measured: ball end 3.5e-4 vs Neumann 0.117 (330x; the mesh floor with
+    // the exact heat kernel as boundary values is 2.6e-4), max over the
+    // run 2.6e-3 (early, t <= 0.05), Pi lower after every step; kappa = 0
+    // (the planar relation) 8.4e-3 (14x); cube (kappa = 0) 2.1e-3 vs
+    // 4.4e-2 (21x), max 5.2e-3. Tolerances ~50 % above the measured
+    // errors; the ratio is the 10x.
+    const auto half_derivative = [](const double kappa) {
+      return [kappa](Abc::EbfParameters &ap) { ap.boundary_curvature = kappa; };
+    };
+    const auto ball_half =
+      diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "least squares", "half derivative", half_derivative(2. / 1.5));
+    check(ball_half[2] >= 10. * ball_half[1] && ball_half[1] < 5.3e-4,
+          "ball, half derivative: end " + sci(ball_half[1]) + " < 5.3e-4, at least 10x closer than Neumann (" +
+            std::to_string(ball_half[2] / ball_half[1]) + "x)");
+    check(ball_half[0] < 4e-3 && ball_half[6] <= 0.,
+          "ball, half derivative: max |Pi - Pi_exact|/Pi0 = " + sci(ball_half[0]) +
+            " < 4e-3, Pi non-increasing every step (largest change " + sci(ball_half[6]) + " Pi0)");
+    const auto cube_half =
+      diffusion_3d(false, 1.5, 4, 0.5, 1e-3, 0.45, "least squares", "half derivative", half_derivative(0.));
+    check(cube_half[2] >= 10. * cube_half[1] && cube_half[0] < 8e-3 && cube_half[6] <= 0.,
+          "cube, half derivative: at least 10x closer than Neumann at t_end (" +
+            std::to_string(cube_half[2] / cube_half[1]) + "x), max " + sci(cube_half[0]) +
+            " < 8e-3, Pi non-increasing every step");
+  }
+
+  /**
+   * Exploratory scan (not a ctest case): FEMBALL_SCAN="key=value;..." with
+   * shape (ball|cube|disk), fit, form, rcond, dinf, dk, nk, nphi, dt,
+   * imposed, ref, t, checksteps; prints the energy errors and the one-step
+   * spectral radius.
+   */
+  void
+  femball_scan()
+  {
+    const char *env = std::getenv("FEMBALL_SCAN");
+    std::map<std::string, std::string> kv{{"shape", "ball"}, {"fit", "least squares"}, {"form", "value"},
+                                          {"rcond", "0"}, {"dinf", "0.45"}, {"dk", "0"}, {"nk", "20"},
+                                          {"nphi", "5"}, {"dt", "1e-3"}, {"imposed", "value"}, {"ref", "3"},
+                                          {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"}};
+    std::string spec = env ? env : "";
+    for (std::size_t pos = 0; pos < spec.size();)
+      {
+        const std::size_t end = std::min(spec.find(';', pos), spec.size());
+        const std::string item = spec.substr(pos, end - pos);
+        const std::size_t eq   = item.find('=');
+        if (eq != std::string::npos)
+          kv[item.substr(0, eq)] = item.substr(eq + 1);
+        pos = end + 1;
+      }
+    const auto tweak = [&](Abc::EbfParameters &ap) {
+      ap.fit_form                 = kv["form"];
+      ap.pseudo_inverse_tolerance = std::stod(kv["rcond"]);
+      ap.wave_number_range        = std::stod(kv["dk"]);
+      ap.n_wave_numbers           = std::stoi(kv["nk"]);
+      ap.n_directions             = std::stoi(kv["nphi"]);
+      ap.stability_check_steps    = std::stoi(kv["checksteps"]);
+      ap.boundary_curvature       = std::stod(kv["kappa"]);
+      if (kv["fit"] != "monotone")
+        ap.max_update_norm = 1e10;
+    };
+    if (root())
+      std::cout << "  scan: " << spec << std::endl;
+    try
+      {
+        if (kv["shape"] == "disk")
+          {
+            const double                R = 3., t_end = std::stod(kv["t"]);
+            Fem::FemDiffusionParameters fp;
+            fp.time_step = std::stod(kv["dt"]);
+            Abc::EbfParameters ap;
+            ap.cloud_radius = std::stod(kv["dinf"]);
+            ap.fit          = kv["fit"];
+            ap.imposed      = kv["imposed"];
+            tweak(ap);
+            HeatKernel       c0;
+            Triangulation<2> tria;
+            disk(R, std::stoi(kv["ref"]))(tria);
+            Fem::FemDiffusion<2> ebf(tria, fp), neumann(tria, fp);
+            ebf.setup(Abc::TruncationBoundary::absorbing, ap, c0);
+            neumann.setup(Abc::TruncationBoundary::neumann, ap, c0);
+            const BoundingBox<2> all(std::make_pair(Point<2>(-R, -R), Point<2>(R, R)));
+            const double         s_end = 1. + 16. * t_end;
+            const double         ee    = M_PI / (8. * s_end) * (1. - std::exp(-8. * R * R / s_end));
+            const double         e0    = M_PI / 8. * (1. - std::exp(-8. * R * R));
+            const unsigned int   n     = static_cast<unsigned int>(std::round(t_end / fp.time_step));
+            double               max_e = 0.;
+            for (unsigned int k = 1; k <= n; ++k)
+              {
+                ebf.advance();
+                neumann.advance();
+                if (k % 100 == 0)
+                  {
+                    const double s = 1. + 16. * ebf.time();
+                    max_e = std::max(max_e, std::abs(ebf.energy(all) - M_PI / (8. * s) * (1. - std::exp(-8. * R * R / s))) / e0);
+                  }
+              }
+            const double end_e = std::abs(ebf.energy(all) - ee) / e0, end_n = std::abs(neumann.energy(all) - ee) / e0;
+            const double arnoldi = kv["imposed"] == "half derivative" ? 0. : ebf.arnoldi_spectral_radius(50, 60);
+            if (root())
+              std::cout << "  disk: EBF end " << sci(end_e) << " max " << sci(max_e) << ", Neumann end " << sci(end_n)
+                        << " (ratio " << end_n / end_e << "), Arnoldi " << arnoldi << ", max|V| "
+                        << sci(ebf.absorbing_boundary().statistics().max_update_norm) << std::endl;
+          }
+        else
+          {
+            const bool ball = kv["shape"] == "ball";
+            const auto r = diffusion_3d(ball, 1.5, std::stoi(kv["ref"]), std::stod(kv["t"]), std::stod(kv["dt"]),
+                                        std::stod(kv["dinf"]), kv["fit"], kv["imposed"], tweak,
+                                        kv["distributed"] == "1");
+            if (root())
+              std::cout << "  RESULT ratio " << r[2] / r[1] << " end " << std::setprecision(13) << r[1] << " max "
+                        << r[0] << std::setprecision(6) << std::endl;
+          }
+      }
+    catch (const ParameterError &e)
+      {
+        if (root())
+          std::cout << "  ParameterError: " << e.what() << std::endl;
+      }
   }
 } // namespace
 
@@ -802,5 +967,6 @@ main(int argc, char **argv)
              {{"rank_invariance_diffusion", rank_invariance_diffusion},
               {"disk_diffusion", disk_diffusion},
               {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave},
-              {"disk_wave_scan", disk_wave_scan}});
+              {"disk_wave_scan", disk_wave_scan},
+              {"femball_scan", femball_scan}});
 }

@@ -75,6 +75,20 @@ namespace PeriDEAL
        * combination, the boundary value can fall below its cloud's.
        */
       std::string imposed = "value";
+      /**
+       * Imposed = "half derivative" (FEM, forward Euler with lumped mass):
+       * the sum of the principal curvatures of the truncation boundary
+       * (2/R on a sphere of radius R, 1/R on a circle, 0 on flat faces).
+       * The flux is dC/dn = -(curvature/2) C - D^{-1/2} d^{1/2}C/dt^{1/2}
+       * at the boundary DoF itself: the relation every planar EBF mode
+       * exp(k n.x + D k^2 t) satisfies (dpsi/dn = k psi, d^{1/2}psi/dt^{1/2}
+       * = sqrt(D) |k| psi), with the curvature term that is exact for the
+       * outgoing monopole in 3D (exp(-sqrt(s/D) r)/r in Laplace space) and
+       * its leading term in 2D. No clouds: the "normal derivative" form
+       * replaces the half derivative by the modes' mean rate |k|, a Robin
+       * constant set by Delta k; here the rate follows the field's history.
+       */
+      double boundary_curvature = 0.;
       /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
       double lower_bound = -1.;
       /**
@@ -98,6 +112,24 @@ namespace PeriDEAL
        * ParameterError naming the cloud where the growing mode lives.
        */
       unsigned int stability_check_steps = 200;
+      /**
+       * Relative singular-value cutoff of M_G^+ for the least-squares and
+       * stabilized fits (LAPACK's rcond: singular values below this times
+       * the largest are dropped; 0: Eigen's rank threshold of the complete
+       * orthogonal decomposition).
+       */
+      double pseudo_inverse_tolerance = 0.;
+      /**
+       * "value" (4.31): V = Psi(0, dt) M_G^+. "increment" (least squares or
+       * stabilized, Imposed = value): the fit extrapolates the change over
+       * one step, V = e_i + (Psi(0, dt) - Psi(0, 0)) M_G^+, so that
+       * C_i^{n+1} = C_i^n + W . G^n with sum_j W_j = 0 for a constant
+       * field, W -> 0 as dt -> 0 even under a cut pseudo-inverse. Identical
+       * to "value" when M_G M_G^+ = I (as many retained singular values as
+       * cloud points). W is signed, so the boundary value can fall below
+       * its whole cloud, which no convex combination can.
+       */
+      std::string fit_form = "value";
 
       static void
       declare_parameters(ParameterHandler &prm);

@@ -69,7 +69,13 @@ namespace PeriDEAL
        * mass) they keep their FEM rows and the EBF normal derivative enters
        * as the flux D dC/dn (fit "monotone": dC/dn = sum_j P_j (C_j - C_i)
        * - q C_i with P, q >= 0, a Robin-type sink that keeps the row an
-       * M-matrix row). The "stabilized" fit blends by
+       * M-matrix row). With "half derivative" (forward Euler, lumped mass)
+       * the boundary DoFs keep their FEM rows with the flux dC/dn =
+       * -(kappa/2) C - D^{-1/2} d^{1/2}C/dt^{1/2} of their own history
+       * (Gruenwald-Letnikov, the current level implicitly; no clouds and no
+       * one-step check, the map has memory), and the step must keep the
+       * boundary rows nonnegative (ParameterError naming FEM/Time step).
+       * The "stabilized" fit blends by
        * Abc::EbfDiffusionAbc::stabilize with this map.
        * Throws ParameterError if the explicit step is unstable, or (absorbing,
        * EbfParameters::stability_check_steps > 0) if the one-step map with
@@ -165,6 +171,9 @@ namespace PeriDEAL
        */
       double
       power_iterate(const unsigned int n_steps);
+      /** Imposed = half derivative: append C^n of the boundary DoFs to the history; boundary_values = its part of the half derivative at t^{n+1}. */
+      void
+      half_derivative_flux();
       /** C = the pseudo-random start on the owned cloud DoFs (seeded by global id), normalized. */
       void
       random_cloud_start();
@@ -199,6 +208,16 @@ namespace PeriDEAL
       DistributedVector              flux_weight;
       /** Imposed = normal derivative: the absorbing DoFs keep their FEM rows and get the EBF flux. */
       bool                           flux_boundary = false;
+      /**
+       * Imposed = half derivative: the boundary DoFs, the curvature sum, the
+       * boundary values of every past level (level-major), the number of
+       * levels and the Gruenwald-Letnikov weights.
+       */
+      bool                           half_derivative = false;
+      std::vector<unsigned int>      half_dofs;
+      double                         half_curvature = 0.;
+      std::vector<double>            half_history, gl_weights;
+      unsigned int                   n_history_levels = 0;
       SolverControl                  solver_control;
       std::unique_ptr<TrilinosWrappers::SolverDirect> solver;
       Abc::EbfDiffusionAbc<dim>      abc;
