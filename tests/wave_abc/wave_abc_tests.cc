@@ -1702,110 +1702,6 @@ namespace
       }
   }
 
-
-  /**
-   * Settings "key=value ..." of the exploratory E15 scans: kv receives
-   * every pair, the result the absorbing-boundary parameters (keys dk, nk,
-   * nphi, dphi, cone, cloud, layer, tol, levels, points, thin, lattice,
-   * ldamp, filter, form, disp).
-   */
-  WaveAbcParameters
-  parse_e15_settings(const std::string &text, std::map<std::string, std::string> &kv)
-  {
-    std::istringstream in(text);
-    std::string        item;
-    while (in >> item)
-      {
-        const auto eq = item.find('=');
-        kv[item.substr(0, eq)] = item.substr(eq + 1);
-      }
-    const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-    const auto str = [&](const std::string &k, const std::string &def) { return kv.count(k) ? kv[k] : def; };
-    WaveAbcParameters prm;
-    prm.cone_angle               = num("cone", 0.5);
-    prm.dispersion               = str("disp", "discrete");
-    prm.wave_number_range        = num("dk", 1.);
-    prm.n_wave_numbers           = static_cast<unsigned int>(num("nk", 10));
-    prm.n_directions             = static_cast<unsigned int>(num("nphi", 10));
-    prm.direction_range          = num("dphi", M_PI / 4.);
-    prm.cloud_radius             = num("cloud", 0.);
-    prm.layer_thickness          = num("layer", 0.);
-    prm.pseudo_inverse_tolerance = num("tol", 0.);
-    prm.n_time_levels            = static_cast<unsigned int>(num("levels", 2));
-    prm.cloud_points             = str("points", prm.cloud_points);
-    prm.thinning                 = str("thin", prm.thinning);
-    prm.lattice_modes            = str("lattice", prm.lattice_modes);
-    prm.lattice_mode_damping     = num("ldamp", 0.);
-    prm.layer_filter             = num("filter", 0.);
-    prm.fit_form                 = str("form", prm.fit_form);
-    return prm;
-  }
-
-  // Exploratory (not registered): one-step spectral radius of the R = 2.5
-  // disc for E15-type layers (doc/design.md, session 11). E15_SCAN is a
-  // list of runs separated by ';', each "key=value ..." (parse_e15_settings,
-  // plus m, R, dt and diag=1 for the dominant mode).
-  void
-  e15_scan()
-  {
-    const char        *env = std::getenv("E15_SCAN");
-    std::istringstream runs(env ? env : "m=3");
-    std::string        run;
-    while (std::getline(runs, run, ';'))
-      {
-        std::map<std::string, std::string> kv;
-        const WaveAbcParameters            prm = parse_e15_settings(run, kv);
-        const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-        unsigned int            n_up = 0;
-        WaveCloudStatistics     st;
-        WaveSpectralDiagnostics diag;
-        const double            rho = radius_2d(num("R", 2.5), prm, 0.25, num("m", 3), &n_up, &st, nullptr,
-                                     kv.count("diag") ? &diag : nullptr, WaveTruncation::absorbing, num("dt", 0.02));
-        std::cout << "    [" << run << "] rho - 1 = " << sci(rho - 1.) << " (" << n_up << " up), cloud "
-                  << st.min_cloud_size << "-" << st.max_cloud_size << ", thinned " << st.n_thinned
-                  << " (stride " << st.max_stride << "), cond " << sci(st.max_condition_number) << ", max|V| "
-                  << sci(st.max_update_norm);
-        if (kv.count("diag"))
-          std::cout << ", dominant " << diag.dominant << " |.| - 1 = " << sci(std::abs(diag.dominant) - 1.) << ", layer share "
-                    << diag.layer_fraction << ", v share " << diag.absorbing_v_fraction;
-        std::cout << std::endl;
-      }
-  }
-
-  // Exploratory (not registered): the E15 notch runs for one EBF setting.
-  // E15_RUN="key=value ..." (parse_e15_settings, plus dt, scale and tmul:
-  // run to tmul T and report the small-radius EBF probe error over (T,
-  // tmul T]; long=n: only the small-radius EBF run for n steps, its energy).
-  void
-  e15_run()
-  {
-    const char                        *env = std::getenv("E15_RUN");
-    std::map<std::string, std::string> kv;
-    const WaveAbcParameters            prm = parse_e15_settings(env ? env : "", kv);
-    const auto num   = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-    const double scale = num("scale", 0.5), dt = num("dt", 0.02);
-    if (kv.count("long"))
-      {
-        LatticeParameters    lp;
-        ScalarWaveParameters mp;
-        e15_model(lp, mp, dt);
-        PdUnboundedWave<2> pd(MPI_COMM_WORLD);
-        pd.setup(BallDomain<2>(Point<2>(), 26. * scale), lp, mp, WaveTruncation::absorbing, prm, e15_initial(),
-                 e15_notch_segments(scale));
-        const auto         all = [](const Point<2> &) { return true; };
-        const double       e0  = pd.energy(all);
-        const unsigned int n   = static_cast<unsigned int>(num("long", 1e5));
-        for (unsigned int s = 1; s <= n; ++s)
-          {
-            pd.advance();
-            if (s % (n / 10) == 0)
-              std::cout << "      step " << s << " t " << pd.time() << " E/E0 " << sci(pd.energy(all) / e0) << std::endl;
-          }
-        return;
-      }
-    e15_notches(prm, scale, num("tmul", 1.), dt);
-  }
-
 } // namespace
 
 int
@@ -1832,7 +1728,5 @@ main(int argc, char **argv)
               {"sponge_long", sponge_long},
               {"pml", pml},
               {"pml_long", pml_long},
-              {"pml_scan", pml_scan},
-              {"e15_scan", e15_scan},
-              {"e15_run", e15_run}});
+              {"pml_scan", pml_scan}});
 }
