@@ -1067,8 +1067,9 @@ namespace PeriDEAL
             const std::array<double, 4> *cf1 = coefficients + class_start[node_class[a + 1]];
             const Slot                  *s0  = slot + cloud_start[a];
             const Slot                  *s1  = slot + cloud_start[a + 1];
-            const unsigned int m = std::min(cloud_start[a + 1] - cloud_start[a], cloud_start[a + 2] - cloud_start[a + 1]);
-            double su0 = 0., sv0 = 0., su1 = 0., sv1 = 0.;
+            const unsigned int           m   = std::min(cloud_start[a + 1] - cloud_start[a],
+                                                    cloud_start[a + 2] - cloud_start[a + 1]);
+            double                       su0 = 0., sv0 = 0., su1 = 0., sv1 = 0.;
             for (unsigned int c = 0; c < m; ++c)
               {
                 const std::array<double, 4> &x0 = levels[s0[c]];
