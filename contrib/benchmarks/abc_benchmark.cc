@@ -7,9 +7,9 @@
 //     abc_seconds / step_seconds of advance() (wall; median over blocks of
 //     10 steps). _vs_no_abc: the whole cost, (T_abc - T_none) / T_abc in CPU
 //     time against the same run stepping without any ABC work (interleaved
-//     blocks, median; see pd_wave_fraction). Negative since session 12: the
-//     run with the ABC does not compute the PD sums of the overwritten
-//     layer rows, which the free truncation does;
+//     blocks, median; see pd_wave_fraction). Mostly negative since
+//     session 12: the run with the ABC does not compute the PD sums of the
+//     overwritten layer rows, which the free truncation does;
 //   abc_overhead_fraction_pd_diffusion_{1d,2d}, abc_overhead_fraction_fem_{1d,2d}:
 //     diffusion (the PD keys were abc_overhead_fraction_pd_{1d,2d} before).
 // Sizes: 2D PD box (-4,4)^2, dx = 1/16, delta = 4 dx (16,641 nodes,
