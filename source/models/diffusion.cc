@@ -52,6 +52,21 @@ namespace PeriDEAL
         s += wi[k] * c[ci[k]];
       return s;
     }
+
+    // One row of linear diffusion, kappa (sum_j w_ij c_j - (sum_j w_ij) c_i).
+    inline double
+    linear_row(const std::int32_t *ci,
+               const double       *wi,
+               const unsigned int  m,
+               const double       *c,
+               const double        row_sum,
+               const double        c_i,
+               const double        kappa)
+    {
+      const double s = m < 1024 ? weighted_row_sum_short(ci, wi, m, c) :
+                                  weighted_row_sum_long(ci, wi, m, c);
+      return kappa * (s - row_sum * c_i);
+    }
   } // namespace
 
   void
@@ -234,12 +249,8 @@ namespace PeriDEAL
       {
         const double kappa = kappa_table[0];
         for_standard_rows([&](const unsigned int i) {
-            const std::int32_t *ci = col + row_start[i];
-            const double       *wi = gw + table[i];
-            const unsigned int  m  = row_start[i + 1] - row_start[i];
-            const double        s  = m < 1024 ? weighted_row_sum_short(ci, wi, m, c) :
-                                                weighted_row_sum_long(ci, wi, m, c);
-            r[i] = kappa * (s - row_sum[i] * c[i]);
+            r[i] = linear_row(col + row_start[i], gw + table[i], row_start[i + 1] - row_start[i],
+                              c, row_sum[i], c[i], kappa);
           });
         if (wls) // Omega_w: the WLS rows (weights carry kappa), same short-row kernel
           for (unsigned int k = 0; k < wls->node.size(); ++k)
@@ -327,6 +338,28 @@ namespace PeriDEAL
                                                  e - b, c) :
                         row_value(i);
         }
+  }
+
+  template <int dim>
+  void
+  DiffusionOperator<dim>::apply(const Vector                                   &C,
+                                Vector                                         &rate,
+                                const std::vector<std::array<unsigned int, 2>> &rows) const
+  {
+    AssertThrow(!corrosion && !wls,
+                ExcMessage("apply() on row ranges: linear diffusion without WLS rows only"));
+    const auto          &nb        = disc.neighborhood;
+    const double *const  c         = C.begin();
+    double *const        r         = rate.begin();
+    const std::int32_t  *col       = nb.col.data();
+    const std::uint64_t *row_start = nb.row_start.data();
+    const std::uint64_t *table     = nb.table_start.data();
+    const double        *gw        = geometric_weight.data();
+    const double         kappa     = kappa_table[0];
+    for (const auto &range : rows)
+      for (unsigned int i = range[0]; i < range[1]; ++i)
+        r[i] = linear_row(col + row_start[i], gw + table[i], row_start[i + 1] - row_start[i], c,
+                          row_sum[i], c[i], kappa);
   }
 
   template <int dim>

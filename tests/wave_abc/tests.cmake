@@ -1,6 +1,16 @@
-perideal_add_test_program(wave_abc_tests ${CMAKE_CURRENT_LIST_DIR}/wave_abc_tests.cc)
+perideal_add_test_program(wave_abc_tests ${CMAKE_CURRENT_LIST_DIR}/wave_abc_tests.cc
+  ${CMAKE_CURRENT_LIST_DIR}/reference_stepping.cc)
+# The reference stepping of wave_abc.compact_levels with the library's flags
+# (bitwise comparison with PdUnboundedWave::advance()).
+if(PERIDEAL_NATIVE)
+  set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/reference_stepping.cc
+    PROPERTIES COMPILE_OPTIONS "-march=native;$<$<CONFIG:Release>:-O3>")
+else()
+  set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/reference_stepping.cc
+    PROPERTIES COMPILE_OPTIONS "$<$<CONFIG:Release>:-O3>")
+endif()
 
-foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped shared_vectors)
+foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped shared_vectors compact_levels)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS unit)
 endforeach()
 foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
@@ -14,6 +24,8 @@ foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_no
 endforeach()
 perideal_add_test(NAME wave_abc.shared_vectors.np2 NPROCS 2
   COMMAND $<TARGET_FILE:wave_abc_tests> shared_vectors LABELS mpi)
+perideal_add_test(NAME wave_abc.compact_levels.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:wave_abc_tests> compact_levels LABELS mpi)
 perideal_add_test(NAME wave_abc.pd_2d_ranks.np2 NPROCS 2
   COMMAND $<TARGET_FILE:wave_abc_tests> pd_2d_ranks LABELS mpi)
 # step-7 with a reduced near field (radius 6, t_end = 12).

@@ -34,6 +34,14 @@ using namespace PeriDEAL;
 using namespace PeriDEAL::Abc;
 using namespace PeriDEALTests;
 
+namespace WaveAbcTests
+{
+  void
+  reference_steps(const Discretization<2> &disc, const Abc::EbfWaveAbc<2> &abc,
+                  const DiffusionOperator<2> &op, const std::vector<double> &damping,
+                  const double dt, const unsigned int n_steps, PeriDEAL::Vector &u);
+}
+
 namespace
 {
   /**
@@ -1327,6 +1335,96 @@ namespace
     check(diff_ebf > 1e-6, "ABC active: differs from the free truncation (" + sci(diff_ebf) + ")");
   }
 
+  // The per-step path of PdUnboundedWave (session 12): the absorbing update
+  // from compact cloud levels (EbfWaveAbc::compute_levels(), 16-bit slots)
+  // and the PD operator without the overwritten rows. (a) compute_levels()
+  // against compute() on full-size arrays of level n and n-1 over 6 steps
+  // of arbitrary data: bit for bit (the same products in the same order);
+  // (b) 200 steps of the E14 disc R = 6 (the pulse reaches the layer)
+  // against the stepping written out here as before session 12: every
+  // operator row, u_old and v_old as full-size arrays copied at the cloud
+  // points, compute(); reference_stepping.cc): bit for bit as well. On any
+  // number of ranks.
+  void
+  compact_levels()
+  {
+    WaveAbcParameters prm;
+    prm.cone_angle = 0.5;
+    PdUnboundedWave<2> pd(MPI_COMM_WORLD);
+    setup_e14_disc(pd, 6., WaveTruncation::absorbing, prm);
+    const auto        &disc    = pd.discretization();
+    const auto        &abc     = pd.absorbing_boundary();
+    const unsigned int n_owned = disc.n_owned(), n_local = n_owned + disc.n_ghost();
+    const auto         count   = [](const std::vector<double> &x, const std::vector<double> &y) {
+      unsigned int n = 0;
+      for (unsigned int i = 0; i < x.size(); ++i)
+        n += x[i] == y[i] ? 0 : 1;
+      return Utilities::MPI::sum(n, MPI_COMM_WORLD);
+    };
+    // (a) Values from the global ids, so that ghosts agree with owners.
+    {
+      std::vector<double> u(n_local), v(n_local), u_old, v_old, un, vn, un_levels, vn_levels;
+      const auto          fill = [&](const unsigned int s) {
+        for (unsigned int i = 0; i < n_local; ++i)
+          {
+            u[i] = std::sin(0.37 * disc.id[i] + 1.1 * s);
+            v[i] = std::cos(0.23 * disc.id[i] - 0.7 * s);
+          }
+      };
+      fill(0);
+      EbfWaveAbc<2>::CloudLevels levels;
+      abc.initialize_levels(u.data(), v.data(), levels);
+      u_old = u;
+      v_old = v;
+      unsigned int mismatches = 0;
+      for (unsigned int s = 1; s <= 6; ++s)
+        {
+          fill(s);
+          abc.compute(u.data(), u_old.data(), v.data(), v_old.data(), un, vn);
+          abc.compute_levels(u.data(), v.data(), levels, un_levels, vn_levels);
+          mismatches += count(un, un_levels) + count(vn, vn_levels);
+          u_old = u;
+          v_old = v;
+        }
+      if (root())
+        std::cout << "    compute_levels vs compute, 6 steps, " << abc.statistics().n_absorbing
+                  << " nodes: " << mismatches << " differing values" << std::endl;
+      check(mismatches == 0, "compute_levels() == compute() bit for bit (" + std::to_string(mismatches) + " differ)");
+    }
+    // (b) The reference stepping with the operator and parameters of setup().
+    LatticeParameters    lp;
+    ScalarWaveParameters mp;
+    e14_parameters(lp, mp);
+    ScalarKernel kern;
+    kern.dim      = 2;
+    kern.omega    = mp.omega;
+    kern.exponent = mp.exponent;
+    kern.delta    = lp.delta;
+    DiffusionModelParameters dp;
+    dp.omega             = mp.omega;
+    dp.exponent          = mp.exponent;
+    dp.micro_diffusivity = kern.micro_constant_for(mp.wave_speed * mp.wave_speed);
+    const DiffusionOperator<2> op(disc, dp);
+    PeriDEAL::Vector           u = pd.displacement();
+    WaveAbcTests::reference_steps(disc, abc, op, pd.damping_rates(), mp.time_step, 200, u);
+    for (unsigned int s = 0; s < 200; ++s)
+      pd.advance();
+    double       diff = 0., peak = 0.;
+    unsigned int differ = 0;
+    for (unsigned int i = 0; i < n_owned; ++i)
+      {
+        diff = std::max(diff, std::abs(pd.displacement().local_element(i) - u.local_element(i)));
+        peak = std::max(peak, std::abs(u.local_element(i)));
+        differ += pd.displacement().local_element(i) == u.local_element(i) ? 0 : 1;
+      }
+    diff   = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    peak   = Utilities::MPI::max(peak, MPI_COMM_WORLD);
+    differ = Utilities::MPI::sum(differ, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "    200 steps, R = 6: " << differ << " of " << disc.n_global() << " values of u differ from the reference stepping, max |u - u_reference| = " << sci(diff) << " (max |u| " << sci(peak) << ")" << std::endl;
+    check(differ == 0, "advance() == the reference stepping bit for bit after 200 steps (" + std::to_string(differ) + " differ)");
+  }
+
   // Shared updating vectors (issue 4, doc/benchmarks.md session 11): on a
   // disc centred at a lattice node the normals are radial and the clouds
   // (cones behind the node, inside the disc) depend only on the normal, so
@@ -1604,110 +1702,6 @@ namespace
       }
   }
 
-
-  /**
-   * Settings "key=value ..." of the exploratory E15 scans: kv receives
-   * every pair, the result the absorbing-boundary parameters (keys dk, nk,
-   * nphi, dphi, cone, cloud, layer, tol, levels, points, thin, lattice,
-   * ldamp, filter, form, disp).
-   */
-  WaveAbcParameters
-  parse_e15_settings(const std::string &text, std::map<std::string, std::string> &kv)
-  {
-    std::istringstream in(text);
-    std::string        item;
-    while (in >> item)
-      {
-        const auto eq = item.find('=');
-        kv[item.substr(0, eq)] = item.substr(eq + 1);
-      }
-    const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-    const auto str = [&](const std::string &k, const std::string &def) { return kv.count(k) ? kv[k] : def; };
-    WaveAbcParameters prm;
-    prm.cone_angle               = num("cone", 0.5);
-    prm.dispersion               = str("disp", "discrete");
-    prm.wave_number_range        = num("dk", 1.);
-    prm.n_wave_numbers           = static_cast<unsigned int>(num("nk", 10));
-    prm.n_directions             = static_cast<unsigned int>(num("nphi", 10));
-    prm.direction_range          = num("dphi", M_PI / 4.);
-    prm.cloud_radius             = num("cloud", 0.);
-    prm.layer_thickness          = num("layer", 0.);
-    prm.pseudo_inverse_tolerance = num("tol", 0.);
-    prm.n_time_levels            = static_cast<unsigned int>(num("levels", 2));
-    prm.cloud_points             = str("points", prm.cloud_points);
-    prm.thinning                 = str("thin", prm.thinning);
-    prm.lattice_modes            = str("lattice", prm.lattice_modes);
-    prm.lattice_mode_damping     = num("ldamp", 0.);
-    prm.layer_filter             = num("filter", 0.);
-    prm.fit_form                 = str("form", prm.fit_form);
-    return prm;
-  }
-
-  // Exploratory (not registered): one-step spectral radius of the R = 2.5
-  // disc for E15-type layers (doc/design.md, session 11). E15_SCAN is a
-  // list of runs separated by ';', each "key=value ..." (parse_e15_settings,
-  // plus m, R, dt and diag=1 for the dominant mode).
-  void
-  e15_scan()
-  {
-    const char        *env = std::getenv("E15_SCAN");
-    std::istringstream runs(env ? env : "m=3");
-    std::string        run;
-    while (std::getline(runs, run, ';'))
-      {
-        std::map<std::string, std::string> kv;
-        const WaveAbcParameters            prm = parse_e15_settings(run, kv);
-        const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-        unsigned int            n_up = 0;
-        WaveCloudStatistics     st;
-        WaveSpectralDiagnostics diag;
-        const double            rho = radius_2d(num("R", 2.5), prm, 0.25, num("m", 3), &n_up, &st, nullptr,
-                                     kv.count("diag") ? &diag : nullptr, WaveTruncation::absorbing, num("dt", 0.02));
-        std::cout << "    [" << run << "] rho - 1 = " << sci(rho - 1.) << " (" << n_up << " up), cloud "
-                  << st.min_cloud_size << "-" << st.max_cloud_size << ", thinned " << st.n_thinned
-                  << " (stride " << st.max_stride << "), cond " << sci(st.max_condition_number) << ", max|V| "
-                  << sci(st.max_update_norm);
-        if (kv.count("diag"))
-          std::cout << ", dominant " << diag.dominant << " |.| - 1 = " << sci(std::abs(diag.dominant) - 1.) << ", layer share "
-                    << diag.layer_fraction << ", v share " << diag.absorbing_v_fraction;
-        std::cout << std::endl;
-      }
-  }
-
-  // Exploratory (not registered): the E15 notch runs for one EBF setting.
-  // E15_RUN="key=value ..." (parse_e15_settings, plus dt, scale and tmul:
-  // run to tmul T and report the small-radius EBF probe error over (T,
-  // tmul T]; long=n: only the small-radius EBF run for n steps, its energy).
-  void
-  e15_run()
-  {
-    const char                        *env = std::getenv("E15_RUN");
-    std::map<std::string, std::string> kv;
-    const WaveAbcParameters            prm = parse_e15_settings(env ? env : "", kv);
-    const auto num   = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv[k]) : def; };
-    const double scale = num("scale", 0.5), dt = num("dt", 0.02);
-    if (kv.count("long"))
-      {
-        LatticeParameters    lp;
-        ScalarWaveParameters mp;
-        e15_model(lp, mp, dt);
-        PdUnboundedWave<2> pd(MPI_COMM_WORLD);
-        pd.setup(BallDomain<2>(Point<2>(), 26. * scale), lp, mp, WaveTruncation::absorbing, prm, e15_initial(),
-                 e15_notch_segments(scale));
-        const auto         all = [](const Point<2> &) { return true; };
-        const double       e0  = pd.energy(all);
-        const unsigned int n   = static_cast<unsigned int>(num("long", 1e5));
-        for (unsigned int s = 1; s <= n; ++s)
-          {
-            pd.advance();
-            if (s % (n / 10) == 0)
-              std::cout << "      step " << s << " t " << pd.time() << " E/E0 " << sci(pd.energy(all) / e0) << std::endl;
-          }
-        return;
-      }
-    e15_notches(prm, scale, num("tmul", 1.), dt);
-  }
-
 } // namespace
 
 int
@@ -1730,10 +1724,9 @@ main(int argc, char **argv)
               {"sponge", sponge},
               {"abc_skipped", abc_skipped},
               {"shared_vectors", shared_vectors},
+              {"compact_levels", compact_levels},
               {"sponge_long", sponge_long},
               {"pml", pml},
               {"pml_long", pml_long},
-              {"pml_scan", pml_scan},
-              {"e15_scan", e15_scan},
-              {"e15_run", e15_run}});
+              {"pml_scan", pml_scan}});
 }

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <complex>
+#include <cstdint>
 #include <tuple>
 #include <functional>
 #include <memory>
@@ -363,6 +364,37 @@ namespace PeriDEAL
       void
       compute_values(const double *u, const double *u_old, std::vector<double> &u_new) const;
 
+      /**
+       * Cloud data of compute_levels(): per entry p of cloud_points()
+       * (u^n, u^{n-1}, v^n, v^{n-1}) at that point.
+       */
+      using CloudLevels = std::vector<std::array<double, 4>>;
+
+      /**
+       * The start with level n-1 equal to level n: @p levels [p] =
+       * (u, u, v, v) at cloud point p (@p u, @p v in local numbering, ghosts
+       * valid).
+       */
+      void
+      initialize_levels(const double *u, const double *v, CloudLevels &levels) const;
+
+      /**
+       * compute() on compact cloud data: on entry @p levels holds level
+       * n-1 in its entries 0 and 2 (the previous call's level n, or
+       * initialize_levels()); level n is gathered from @p u, @p v into them
+       * (the old values moving to entries 1 and 3) and u_new, v_new are
+       * compute()'s sums, the same products in the same order. Per cloud
+       * entry it reads 32 contiguous bytes and a 16-bit slot (at most 65,536
+       * cloud points, else 32-bit) instead of four full-size arrays at a
+       * 32-bit index, and no level n-1 copy is written back.
+       */
+      void
+      compute_levels(const double        *u,
+                     const double        *v,
+                     CloudLevels         &levels,
+                     std::vector<double> &u_new,
+                     std::vector<double> &v_new) const;
+
       const std::vector<unsigned int> &
       absorbing_points() const
       {
@@ -411,6 +443,13 @@ namespace PeriDEAL
                              const MPI_Comm                                               comm);
 
       std::vector<unsigned int> absorbing, cloud_start, cloud_index, all_cloud_points;
+      /**
+       * Per entry of cloud_index: its position in all_cloud_points
+       * (compute_levels()), 16 bits if there are at most 65,536 cloud points
+       * (slot16), else 32 bits (slot32); the other one is empty.
+       */
+      std::vector<std::uint16_t> slot16;
+      std::vector<std::uint32_t> slot32;
       /** Class of each absorbing node and the start of each class in coefficients. */
       std::vector<unsigned int> node_class, class_start;
       /** Per class entry: V_G and V_H for levels n and n-1. */
@@ -573,7 +612,9 @@ namespace PeriDEAL
        * with a(u, w) = 1/2 sum_ij k_ij (u_j - u_i)(w_j - w_i) beta V_i V_j
        * (all ranks; needs one advance()). Without an overwritten layer it is
        * non-increasing for any damping d + sigma >= 0 below the critical
-       * step (doc/design.md, session 7).
+       * step (doc/design.md, session 7). With an overwritten (EBF or
+       * first-order) layer the v^{n+1/2} of its nodes is not computed (the
+       * operator skips their rows), so the value is then not meaningful.
        */
       double
       half_step_energy() const;
@@ -582,15 +623,29 @@ namespace PeriDEAL
       /** The dense one-step map (column-major, m x m) of one_step_spectral_radius(). */
       unsigned int
       assemble_one_step_map(const unsigned int max_size, std::vector<double> &map);
-      /** Lu = L u (u with current ghosts), minus the broken bonds. */
+      /**
+       * Lu = L u (u with current ghosts), minus the broken bonds; with
+       * @p all_rows false only on the rows that are not overwritten by the
+       * absorbing update (operator_rows): the other rows of Lu (and so of a
+       * and v_half) are then stale, and are never read for u or v.
+       */
       void
-      apply_operator();
+      apply_operator(const bool all_rows = true);
       Discretization<dim>                     disc;
       std::unique_ptr<DiffusionOperator<dim>> op;
       std::unique_ptr<WaveDispersion<dim>>    relation;
       EbfWaveAbc<dim>                         abc;
       Vector                                  u, v, a, Lu;
-      std::vector<double>                     u_old, v_old, u_abc, v_abc;
+      std::vector<double>                     u_abc, v_abc;
+      /** Levels n, n-1 of u and v at the cloud points (EbfWaveAbc::compute_levels()). */
+      typename EbfWaveAbc<dim>::CloudLevels   cloud_levels;
+      /**
+       * EBF or first-order layer: the owned rows outside it, as ranges
+       * (the PD operator skips the overwritten rows), and the broken bonds
+       * of these rows.
+       */
+      std::vector<std::array<unsigned int, 2>>                    operator_rows;
+      std::vector<std::tuple<unsigned int, unsigned int, double>> broken_operator_rows;
       std::vector<double>                     bond_kernel_weight;
       /** d + sigma(x_i) per owned node; v^{n-1/2} and u^{n-1} of the last step. */
       std::vector<double>                     damping, v_half, u_prev;

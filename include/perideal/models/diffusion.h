@@ -175,6 +175,16 @@ namespace PeriDEAL
     apply(const Vector &C, Vector &rate, const Vector *phase, const Rows rows) const;
 
     /**
+     * Linear diffusion without WLS rows: rate_i = (L C)_i only for the owned
+     * rows i in the half-open ranges @p rows, bitwise the values of apply();
+     * the other entries of @p rate are untouched. For time steppers whose
+     * other rows are overwritten (the EBF absorbing layer of
+     * Abc::PdUnboundedWave), so that their sums are not computed at all.
+     */
+    void
+    apply(const Vector &C, Vector &rate, const std::vector<std::array<unsigned int, 2>> &rows) const;
+
+    /**
      * Largest forward Euler step the Gershgorin theorem proves stable for
      * this boundary treatment: min_i 2 / (|l_ii| + R_i) over the rows of the
      * unknowns, R_i the sum of the couplings to other unknowns (nodes of the
