@@ -6,7 +6,7 @@
 //
 //   kw_hybrid_benchmark [--dx 0.25] [--m 8] [--end-time 87.5e-6] [--sigma 0.95]
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
-//                       [--chunk 16]
+//                       [--chunk 16] [--half-stencil 0|1]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -17,7 +17,10 @@
 // --every-step 1 tests (3.80) on every bond at every step instead of the
 // amortized test (the same result, see HybridBondBasedModel); --bound
 // budget uses StretchBudget per length class instead of the lattice bound
-// (the same result, more exact node tests).
+// (the same result, more exact node tests). --half-stencil 1 evaluates the
+// Omega_s rows as a half-stencil sweep with reactions instead of their full
+// stencils (HybridMechanicsParameters::half_stencil, default off; the same
+// bonds, another summation order).
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
 // at y = +-25). The source uses dx = 0.25 mm, delta = 2 mm (m = 8) and
@@ -73,7 +76,7 @@ main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
-  int         interval = 1, every_step = 0, chunk = 16;
+  int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1;
   std::string dir = "kw-hybrid-benchmark", bound = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
@@ -92,6 +95,8 @@ main(int argc, char **argv)
         every_step = std::stoi(value);
       else if (key == "--bound" && (value == "lattice" || value == "budget"))
         bound = value;
+      else if (key == "--half-stencil")
+        half_stencil = std::stoi(value);
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -113,6 +118,8 @@ main(int argc, char **argv)
   ph.hybrid.check_interval  = interval;
   ph.hybrid.switching_bound = every_step == 0;
   ph.hybrid.lattice_bound   = bound == "lattice";
+  if (half_stencil >= 0)
+    ph.hybrid.half_stencil = half_stencil != 0;
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = cpu_seconds() - t0;

@@ -139,6 +139,24 @@ namespace PeriDEAL
       return l2;
     }
 
+    /**
+     * force[d] at the nodes of the @p lanes of the eight box positions from
+     * @p L0 (node: the node of each box position) = value[d] of the lane.
+     */
+    template <int dim, typename VectorField>
+    inline void
+    store_lane_forces(VectorField &force, const std::int32_t *node, const std::size_t L0,
+                      const unsigned int lanes, const __m512d *value)
+    {
+      alignas(64) double out[dim][8];
+      for (unsigned int d = 0; d < dim; ++d)
+        _mm512_store_pd(out[d], value[d]);
+      for (unsigned int l = 0; l < 8; ++l)
+        if ((lanes >> l) & 1u)
+          for (unsigned int d = 0; d < dim; ++d)
+            force[d].local_element(node[L0 + l]) = out[d][l];
+    }
+
     /** The operations of the exact switching test on W = 8 (512-bit) or 4 (256-bit) lanes. */
     template <int W>
     struct LaneVector;
@@ -447,10 +465,15 @@ namespace PeriDEAL
             sweep_lower[d] = std::min(sweep_lower[d], li[d]);
             upper[d]       = std::max(upper[d], li[d]);
           }
+      // The box starts at a multiple of 8 of the global lattice in x and
+      // its x extent is a multiple of 8: the vectors of eight positions are
+      // the same blocks of a lattice row on every rank (the half-stencil
+      // sweep relies on it; the other kernels do not depend on the box).
+      sweep_lower[0] -= ((sweep_lower[0] % 8) + 8) % 8;
       for (unsigned int d = 0; d < dim; ++d)
         {
           sweep_stride[d] = n_box;
-          n_box *= upper[d] - sweep_lower[d] + 1;
+          n_box *= d == 0 ? 8 * ((upper[d] - sweep_lower[d] + 8) / 8) : upper[d] - sweep_lower[d] + 1;
         }
       if (n_box > 8 * std::int64_t(n_local) + 4096 || n_box > (std::int64_t(1) << 30))
         return false;
@@ -594,6 +617,36 @@ namespace PeriDEAL
       p_epoch = 0;
     }
     sweep_on         = true;
+    half_on          = dim == 2 && prm.half_stencil;
+    // The positive offsets by x offset, then y offset: consecutive ones lie
+    // a lattice row or more apart, so that the reaction update of one does
+    // not partially overlap the previous one's (no store forwarding).
+    half_offsets.clear();
+    for (unsigned int f = 0; f < sweep_offset.size(); ++f)
+      if (sweep_offset[f] > 0)
+        half_offsets.push_back(f);
+    {
+      const int W = 2 * box_radius + 1;
+      std::stable_sort(half_offsets.begin(), half_offsets.end(),
+                       [&](const unsigned int a, const unsigned int b) {
+                         return sweep_box[a] % W < sweep_box[b] % W;
+                       });
+    }
+    half_slot.assign(sweep_offset.size(), -1);
+    half_o.resize(half_offsets.size());
+    half_constants.resize(half_offsets.size());
+    for (unsigned int h = 0; h < half_offsets.size(); ++h)
+      {
+        const unsigned int g = half_offsets[h];
+        half_slot[g]         = h;
+        half_o[h]            = sweep_offset[g];
+        half_constants[h]    = {{sweep_k[g], sweep_kr[g], sweep_t2[g]}};
+      }
+    if (half_on)
+      {
+        half_reaction.assign(dim * sweep_n_alloc, 0.);
+        half_acc.assign(dim * sweep_n_alloc, 0.);
+      }
 
     all_offsets.resize(sweep_offset.size());
     for (unsigned int f = 0; f < all_offsets.size(); ++f)
@@ -759,9 +812,10 @@ namespace PeriDEAL
     const auto        &nb = disc.neighborhood;
     const std::size_t  nv = sweep_n_vectors;
     const std::size_t  n_f = sweep_offset.size();
-    // One spare vector of zeros: the Omega_s runs read the bits of the
-    // vector after theirs.
-    sweep_live.assign(n_f * (nv + 1), 0);
+    // Spare vectors of zeros: the Omega_s runs read the bits of the vector
+    // after theirs, the half-stencil sweep those of the vectors up to the
+    // stencil reach (sweep_pad) after its own.
+    sweep_live.assign(n_f * (nv + sweep_pad / 8 + 2), 0);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         const std::uint32_t L = sweep_position[i];
@@ -770,6 +824,7 @@ namespace PeriDEAL
             sweep_live[(L / 8) * n_f + sweep_of_box[box_index(i, b)]] |= std::uint8_t(1u << (L % 8));
       }
     sweep_live_valid = true;
+    half_mask_valid  = false;
   }
 
   template <int dim>
@@ -856,8 +911,55 @@ namespace PeriDEAL
       else
         standard_start_lanes.back() |= std::uint8_t(1u << (L - standard_start.back()));
     std::vector<std::uint8_t> read(p_stamp.size(), 0);
-    for (const std::uint32_t L0 : standard_start)
-      for_each_p_chunk(L0, [&](const std::size_t c) { read[c] = 1; });
+    if (half_on)
+      {
+        // The vectors of owned Omega_s lanes, and every vector that holds
+        // the lower end M = L - o_g of a bond of such a lane L.
+        const std::size_t nv = sweep_n_vectors;
+        standard_lanes.assign(nv + sweep_pad / 8 + 2, 0);
+        for (const std::uint32_t L : positions)
+          standard_lanes[L / 8] |= std::uint8_t(1u << (L % 8));
+        std::vector<std::uint8_t> in_sweep(nv, 0);
+        for (std::uint32_t v = 0; v < nv; ++v)
+          if (standard_lanes[v])
+            {
+              in_sweep[v] = 1;
+              for (const unsigned int g : half_offsets)
+                {
+                  const std::int64_t lo = 8 * std::int64_t(v) - sweep_offset[g];
+                  for (const std::int64_t w : {lo, lo + 7})
+                    if (w >= 0 && w / 8 < std::int64_t(nv))
+                      in_sweep[w / 8] = 1;
+                }
+            }
+        // Tiles of half_tile lattice columns (from a multiple of half_tile
+        // of the global lattice), each row by row: the reactions and
+        // positions a tile touches stay in the L1 cache (whole rows did
+        // not). The order is a function of the lattice positions only.
+        half_groups.clear();
+        standard_vectors.clear();
+        for (std::uint32_t v = 0; v < nv; ++v)
+          if (in_sweep[v])
+            {
+              half_groups.push_back(v);
+              if (standard_lanes[v])
+                standard_vectors.push_back(v);
+              for_each_p_chunk(8 * std::int64_t(v), [&](const std::size_t c) { read[c] = 1; });
+            }
+        const auto tile = [&](const std::uint32_t v) {
+          const std::int64_t x = 8 * std::int64_t(v) % sweep_stride[1] + sweep_lower[0];
+          return (x >= 0 ? x : x - half_tile + 1) / half_tile;
+        };
+        std::stable_sort(half_groups.begin(), half_groups.end(),
+                         [&](const std::uint32_t a, const std::uint32_t b) { return tile(a) < tile(b); });
+        half_index.assign(nv, -1);
+        for (std::size_t k = 0; k < half_groups.size(); ++k)
+          half_index[half_groups[k]] = k;
+        half_mask_valid = false;
+      }
+    else
+      for (const std::uint32_t L0 : standard_start)
+        for_each_p_chunk(L0, [&](const std::size_t c) { read[c] = 1; });
     standard_chunks.clear();
     for (std::size_t c = 0; c < read.size(); ++c)
       if (read[c])
@@ -1282,26 +1384,152 @@ namespace PeriDEAL
                 if ((brk >> l) & 1u)
                   sweep_broken.emplace_back(f, std::uint32_t(L0 + l));
           }
-        alignas(64) double out[dim][8];
-        for (unsigned int d = 0; d < dim; ++d)
-          _mm512_store_pd(out[d], acc[d]);
-        for (unsigned int l = 0; l < 8; ++l)
-          if ((lanes >> l) & 1u)
-            for (unsigned int d = 0; d < dim; ++d)
-              force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+        store_lane_forces<dim>(force, sweep_node.data(), L0, lanes, acc);
       }
-    // Clear both bits of a broken bond and flag its owned CSR copies.
+    return apply_sweep_broken();
+#else
+    (void)force;
+    return false;
+#endif
+  }
+
+  template <int dim>
+  bool
+  HybridBondBasedModel<dim>::apply_sweep_broken()
+  {
+    const std::size_t  n_f     = sweep_offset.size();
+    const std::int32_t n_owned = disc.n_owned();
     for (const auto &[f, L] : sweep_broken)
       {
         const std::uint32_t M = L + sweep_offset[f];
         const unsigned int  g = sweep_mirror[f];
         sweep_live[(L / 8) * n_f + f] &= std::uint8_t(~(1u << (L % 8)));
         sweep_live[(M / 8) * n_f + g] &= std::uint8_t(~(1u << (M % 8)));
-        broken_flag[find_bond(sweep_node[L], sweep_box[f])] = 1;
-        if (sweep_node[M] < std::int32_t(disc.n_owned()))
+        // The half-stencil sweep's entries are (positive offset, lower end).
+        if (half_mask_valid && sweep_offset[f] > 0 && half_index[L / 8] >= 0)
+          half_mask[std::size_t(half_index[L / 8]) * half_offsets.size() + half_slot[f]] &=
+            std::uint8_t(~(1u << (L % 8)));
+        if (sweep_node[L] < n_owned)
+          broken_flag[find_bond(sweep_node[L], sweep_box[f])] = 1;
+        if (sweep_node[M] < n_owned)
           broken_flag[find_bond(sweep_node[M], sweep_box[g])] = 1;
       }
     return !sweep_broken.empty();
+  }
+
+  template <int dim>
+  void
+  HybridBondBasedModel<dim>::build_half_mask()
+  {
+    // Bond (M, M + o_g) of lane M is evaluated if alive in M's row and M is
+    // an owned Omega_s node, or alive in the row of M + o_g (the mirror
+    // offset) and that one is (a ghost or Omega_w row at M is not read).
+    const std::size_t   n_f = sweep_offset.size(), n_h = half_offsets.size();
+    const std::uint8_t *live = sweep_live.data(), *own = standard_lanes.data();
+    half_mask.assign(half_groups.size() * n_h, 0);
+    for (std::size_t k = 0; k < half_groups.size(); ++k)
+      {
+        const std::size_t v = half_groups[k];
+        for (unsigned int h = 0; h < n_h; ++h)
+          {
+            const unsigned int  g  = half_offsets[h];
+            const std::int64_t  o  = sweep_offset[g];
+            const std::size_t   w  = v + std::size_t(o) / 8;
+            const std::uint8_t *bm = live + sweep_mirror[g];
+            const unsigned      other =
+              (bm[w * n_f] | (unsigned(bm[(w + 1) * n_f]) << 8)) & (own[w] | (unsigned(own[w + 1]) << 8));
+            half_mask[k * n_h + h] = std::uint8_t((live[v * n_f + g] & own[v]) | (other >> (o % 8)));
+          }
+      }
+    half_mask_valid = true;
+  }
+
+  template <int dim>
+  bool
+  HybridBondBasedModel<dim>::sweep_half_rows(VectorField &force)
+  {
+#ifdef PERIDEAL_HYBRID_SWEEP
+    if (!half_mask_valid)
+      build_half_mask();
+    const std::size_t   N = sweep_n_alloc, n_h = half_offsets.size();
+    const double       *p = sweep_p.data() + sweep_pad;
+    double             *R = half_reaction.data() + sweep_pad, *A = half_acc.data() + sweep_pad;
+    const std::uint8_t *own = standard_lanes.data();
+    // Per slot h (the order of half_offsets): offset, k, k r, (r + s0 r)^2.
+    const std::int64_t *o = half_o.data();
+    const std::array<double, 3> *c = half_constants.data();
+    for (const std::uint32_t ch : standard_chunks)
+      if (p_stamp[ch] != p_epoch)
+        fill_p_chunk(ch);
+    // Reactions are read only at the vectors with owned Omega_s lanes; the
+    // other positions of the array are written, never read.
+    for (const std::uint32_t v : standard_vectors)
+      for (unsigned int d = 0; d < dim; ++d)
+        _mm512_storeu_pd(R + d * N + 8 * std::size_t(v), _mm512_setzero_pd());
+    sweep_broken.clear();
+    half_broken_lanes.assign(n_h, 0);
+    std::uint8_t *const broken_lanes = half_broken_lanes.data();
+    bool                any_broken   = false;
+    for (std::size_t k = 0; k < half_groups.size(); ++k)
+      {
+        const std::size_t   L0 = 8 * std::size_t(half_groups[k]);
+        const std::uint8_t *mask = half_mask.data() + k * n_h;
+        __m512d             pi[dim], f[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            pi[d] = _mm512_loadu_pd(p + d * N + L0);
+            f[d]  = _mm512_setzero_pd();
+          }
+        for (unsigned int h = 0; h < n_h; ++h)
+          {
+            const __mmask8 alive = mask[h];
+            if (alive == 0)
+              continue;
+            __m512d y[dim];
+            for (unsigned int d = 0; d < dim; ++d)
+              y[d] = _mm512_sub_pd(_mm512_loadu_pd(p + d * N + L0 + o[h]), pi[d]);
+            __m512d l2 = _mm512_mul_pd(y[0], y[0]);
+            for (unsigned int d = 1; d < dim; ++d)
+              l2 = _mm512_fmadd_pd(y[d], y[d], l2);
+            __mmask8      brk;
+            const __m512d scale = internal::LatticeSweep::pmb_bond_scale_kr<false>(
+              l2, alive, _mm512_set1_pd(c[h][0]), _mm512_set1_pd(c[h][1]), _mm512_set1_pd(c[h][2]), brk);
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                double *r = R + d * N + L0 + o[h];
+                f[d]      = _mm512_fmadd_pd(scale, y[d], f[d]);
+                _mm512_storeu_pd(r, _mm512_fmadd_pd(scale, y[d], _mm512_loadu_pd(r)));
+              }
+            // Recorded after the loop: a call here (emplace_back) made GCC
+            // keep f on the stack, a store-load chain per bond vector.
+            if (__builtin_expect(brk != 0, 0))
+              {
+                broken_lanes[h] = brk;
+                any_broken      = true;
+              }
+          }
+        if (__builtin_expect(any_broken, 0))
+          {
+            for (unsigned int h = 0; h < n_h; ++h)
+              for (unsigned int l = 0; l < 8; ++l)
+                if ((broken_lanes[h] >> l) & 1u)
+                  sweep_broken.emplace_back(half_offsets[h], std::uint32_t(L0 + l));
+            std::fill(broken_lanes, broken_lanes + n_h, 0);
+            any_broken = false;
+          }
+        if (own[L0 / 8])
+          for (unsigned int d = 0; d < dim; ++d)
+            _mm512_storeu_pd(A + d * N + L0, f[d]);
+      }
+    for (const std::uint32_t v : standard_vectors)
+      {
+        const std::size_t  L0   = 8 * std::size_t(v);
+        __m512d F[dim];
+        for (unsigned int d = 0; d < dim; ++d)
+          F[d] = _mm512_sub_pd(_mm512_loadu_pd(A + d * N + L0), _mm512_loadu_pd(R + d * N + L0));
+        store_lane_forces<dim>(force, sweep_node.data(), L0, own[v], F);
+      }
+    return apply_sweep_broken();
 #else
     (void)force;
     return false;
@@ -1325,13 +1553,7 @@ namespace PeriDEAL
     const double       *Wt  = shared_weight.data();
     const std::int64_t *off = shared_offset.data();
     const auto          store = [&](const std::size_t L0, const __mmask8 lanes, const __m512d *acc) {
-      alignas(64) double out[dim][8];
-      for (unsigned int d = 0; d < dim; ++d)
-        _mm512_store_pd(out[d], acc[d]);
-      for (unsigned int l = 0; l < 8; ++l)
-        if ((lanes >> l) & 1u)
-          for (unsigned int d = 0; d < dim; ++d)
-            force[d].local_element(sweep_node[L0 + l]) = out[d][l];
+      store_lane_forces<dim>(force, sweep_node.data(), L0, lanes, acc);
     };
     const std::size_t n_v = shared_vectors.size();
     std::size_t       k   = 0;
@@ -1444,7 +1666,7 @@ namespace PeriDEAL
     start = cpu_seconds();
     if (sweep_on)
       {
-        op_stale = sweep_standard_rows(force) || op_stale;
+        op_stale = (half_on ? sweep_half_rows(force) : sweep_standard_rows(force)) || op_stale;
         seconds[1] += (cpu_seconds() - start);
         start = cpu_seconds();
         sweep_wls_rows(force);

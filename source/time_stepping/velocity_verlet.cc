@@ -10,6 +10,17 @@ namespace PeriDEAL
 {
   namespace
   {
+    /**
+     * a = (f + b) / rho, the one expression of every acceleration update
+     * (node vectors, fused half-kick, box path), so that all of them give
+     * bitwise the same value.
+     */
+    inline double
+    acceleration_of(const double f, const double b, const double inv_rho)
+    {
+      return inv_rho * (f + b);
+    }
+
     // The MechanicsModel of an operator held by reference. The bond-based
     // and LPS operators share these member names.
     template <int dim, class Operator>
@@ -270,16 +281,27 @@ namespace PeriDEAL
   }
 
   template <int dim>
-  void
-  VelocityVerlet<dim>::apply_prescribed_velocities(const double time)
+  std::vector<unsigned int>
+  VelocityVerlet<dim>::velocity_held_nodes() const
   {
+    std::vector<unsigned int> nodes;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       if (prescribed_set[i] >= 0)
-        {
-          const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time);
-          for (unsigned int d = 0; d < dim; ++d)
-            velocity[d].local_element(i) = v[d];
-        }
+        nodes.push_back(i);
+    return nodes;
+  }
+
+  template <int dim>
+  void
+  VelocityVerlet<dim>::apply_prescribed_velocities(const double                     time,
+                                                   const std::vector<unsigned int> &nodes)
+  {
+    for (const unsigned int i : nodes)
+      {
+        const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time);
+        for (unsigned int d = 0; d < dim; ++d)
+          velocity[d].local_element(i) = v[d];
+      }
   }
 
   template <int dim>
@@ -295,7 +317,7 @@ namespace PeriDEAL
         acceleration[d].local_element(i) =
           (prescribed_set[i] >= 0 || displacement_set[i] >= 0) ?
             0. :
-            inv_rho * (force[d].local_element(i) + body_force[d].local_element(i));
+            acceleration_of(force[d].local_element(i), body_force[d].local_element(i), inv_rho);
   }
 
   template <int dim>
@@ -333,7 +355,7 @@ namespace PeriDEAL
     // The caller has set the node vectors: they are the state.
     node_vectors_stale = false;
     box_current        = false;
-    apply_prescribed_velocities(t);
+    apply_prescribed_velocities(t, velocity_held_nodes());
     apply_prescribed_displacements(t, false);
     update_accelerations();
     allocate_box();
@@ -374,15 +396,12 @@ namespace PeriDEAL
     // b is +0 everywhere without a body force function (a -0 would change
     // the sign of a zero force sum).
     sync_node_vectors();
-    const unsigned int        n_owned = disc.n_owned();
-    std::vector<unsigned int> held, velocity_held;
+    const unsigned int              n_owned       = disc.n_owned();
+    const std::vector<unsigned int> velocity_held = velocity_held_nodes();
+    std::vector<unsigned int>       held;
     for (unsigned int i = 0; i < n_owned; ++i)
-      {
-        if (is_held(i))
-          held.push_back(i);
-        if (prescribed_set[i] >= 0)
-          velocity_held.push_back(i);
-      }
+      if (is_held(i))
+        held.push_back(i);
     bool zero_body = !body_force_function;
     for (unsigned int d = 0; d < dim && zero_body; ++d)
       for (unsigned int i = 0; i < n_owned; ++i)
@@ -391,14 +410,6 @@ namespace PeriDEAL
           zero_body      = zero_body && b == 0. && !std::signbit(b);
         }
     std::vector<double> held_velocity(held.size());
-    const auto          set_velocities = [&](const double time) {
-      for (const unsigned int i : velocity_held)
-        {
-          const Tensor<1, dim> v = prescribed_values[prescribed_set[i]](disc.position[i], time);
-          for (unsigned int d = 0; d < dim; ++d)
-            velocity[d].local_element(i) = v[d];
-        }
-    };
     const double inv_rho = 1. / rho;
     for (unsigned int s = 0; s < n; ++s)
       {
@@ -407,7 +418,7 @@ namespace PeriDEAL
         // the difference quotient (set first: it needs u^n); velocity sets
         // drift with the midpoint velocity.
         apply_prescribed_displacements(t + dt, true);
-        set_velocities(t + 0.5 * dt);
+        apply_prescribed_velocities(t + 0.5 * dt, velocity_held);
         for (unsigned int d = 0; d < dim; ++d)
           {
             double       *u = displacement[d].begin();
@@ -420,7 +431,7 @@ namespace PeriDEAL
               }
           }
         apply_prescribed_displacements(t + dt, false);
-        set_velocities(t + dt);
+        apply_prescribed_velocities(t + dt, velocity_held);
         if (body_force_function)
           body_force_function(t + dt, body_force);
         for (auto &u : displacement)
@@ -440,13 +451,13 @@ namespace PeriDEAL
             if (zero_body)
               for (unsigned int i = 0; i < n_owned; ++i)
                 {
-                  a[i] = inv_rho * (f[i] + 0.);
+                  a[i] = acceleration_of(f[i], 0., inv_rho);
                   v[i] += 0.5 * dt * a[i];
                 }
             else
               for (unsigned int i = 0; i < n_owned; ++i)
                 {
-                  a[i] = inv_rho * (f[i] + b[i]);
+                  a[i] = acceleration_of(f[i], b[i], inv_rho);
                   v[i] += 0.5 * dt * a[i];
                 }
             for (std::size_t k = 0; k < held.size(); ++k)
@@ -547,7 +558,7 @@ namespace PeriDEAL
           for (std::size_t L = 0; L < N; ++L)
             if (kind[L] == 2)
               {
-                const double a = inv_rho * (f[L] + b[L]);
+                const double a = acceleration_of(f[L], b[L], inv_rho);
                 v[L] += h0 * a;
                 u[L] += tau0 * v[L];
                 p[L] = x[L] + u[L];
@@ -723,7 +734,7 @@ namespace PeriDEAL
             const std::size_t L = pos[i];
             vn[i]               = v[L];
             fn[i]               = f[L];
-            an[i]               = kind[L] == 1 ? 0. : inv_rho * (f[L] + b[i]);
+            an[i]               = kind[L] == 1 ? 0. : acceleration_of(f[L], b[i], inv_rho);
           }
       }
   }

@@ -7,13 +7,16 @@
 //  kw:        the Kalthoff-Winkler run at CI size against the uniform
 //             standard scheme (damage, crack length and angle; Omega_s grows
 //             only near the crack);
-//  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage;
+//  rank_invariance: 1 vs 2 ranks give the same Omega_s and damage (full-
+//             and half-stencil Omega_s rows);
 //  bad_input: ParameterError for bad Hybrid entries;
 //  stretch_budget: the bound of StretchBudget (stretch_budget_test.h);
 //  kw_classes: amortized = every-step test with two bond length classes
 //             (StretchBudget);
 //  kw_lattice: amortized = every-step test with the lattice bound (and
 //             fewer exact node tests than with StretchBudget);
+//  half_stencil: the half-stencil Omega_s sweep = the full-stencil rows
+//             (broken bonds, switching, damage; forces to round-off);
 //  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
 //             source's horizon delta = 2 mm covers the source's 9.72 % of
 //             the plate (Table 3.3), and twice that at delta = 4 mm.
@@ -37,19 +40,29 @@ using namespace PeriDEALTests;
 
 namespace
 {
+  // The 40 x 40 box of (a), (d) and (i): dx = 1, delta = 4 (m = 4),
+  // cell-centred.
+  constexpr double box_size = 40.;
+  LatticeParameters
+  setup_box(Discretization<2> &disc)
+  {
+    LatticeParameters lp;
+    lp.dx            = 1.;
+    lp.delta         = 4.;
+    lp.cell_centered = true;
+    disc.setup(BoxDomain<2>(Point<2>(0., 0.), Point<2>(box_size, box_size)), lp);
+    return lp;
+  }
+
   // (a) Patch test on a 40 x 40 box, dx = 1, delta = 4 (m = 4), E = 1,
   // plane strain, no breaking. Omega_s = the band of width delta along the
   // boundary plus the left half, so bulk nodes of both schemes exist.
   void
   patch()
   {
-    LatticeParameters lp;
-    lp.dx            = 1.;
-    lp.delta         = 4.;
-    lp.cell_centered = true;
-    const double L = 40.;
-    Discretization<2> disc(MPI_COMM_WORLD);
-    disc.setup(BoxDomain<2>(Point<2>(0., 0.), Point<2>(L, L)), lp);
+    Discretization<2>       disc(MPI_COMM_WORLD);
+    const LatticeParameters lp = setup_box(disc);
+    const double            L  = box_size;
     BondBasedModelParameters mp;
     mp.plane_stress = false;
     BondBasedOperator<2> op(disc, mp);
@@ -152,13 +165,9 @@ namespace
   void
   sweep()
   {
-    LatticeParameters lp;
-    lp.dx            = 1.;
-    lp.delta         = 4.;
-    lp.cell_centered = true;
-    const double      L = 40.;
-    Discretization<2> disc(MPI_COMM_WORLD);
-    disc.setup(BoxDomain<2>(Point<2>(0., 0.), Point<2>(L, L)), lp);
+    Discretization<2>       disc(MPI_COMM_WORLD);
+    const LatticeParameters lp = setup_box(disc);
+    const double            L  = box_size;
     BondBasedModelParameters mp;
     BondBasedOperator<2>     op(disc, mp);
     std::vector<bool>        standard(disc.n_owned());
@@ -246,6 +255,106 @@ namespace
                                sci(wls_diff) + " <= 1e-12");
     check(std_diff <= 1e-12, "standard sweep rows vs BondBasedOperator: max |dF| / max |F| = " +
                                sci(std_diff) + " <= 1e-12");
+  }
+
+  // (i) The half-stencil Omega_s sweep (HybridMechanicsParameters::
+  // half_stencil, each bond once with its reaction) against the full-stencil
+  // rows on the box of (d) with breaking (s0 = 0.01): a ragged Omega_s
+  // (a slanted half, the boundary band and isolated nodes inside Omega_w)
+  // and a displacement jump across y = 20.3 whose height grows with x, so
+  // that some crossing bonds break and others do not. Two evaluations (the
+  // second after breaking and switching): the same broken bonds, switched
+  // nodes and damage, forces equal up to the summation order.
+  void
+  half_stencil()
+  {
+    Discretization<2>       disc(MPI_COMM_WORLD);
+    const LatticeParameters lp = setup_box(disc);
+    const double            L  = box_size;
+    BondBasedModelParameters mp;
+    mp.critical_stretch = 0.01;
+    std::vector<bool> standard(disc.n_owned());
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const auto &x = disc.position[i];
+        standard[i]   = x[0] + 0.7 * x[1] < 23. ||
+                      std::min(std::min(x[0], L - x[0]), std::min(x[1], L - x[1])) < lp.delta ||
+                      disc.id[i] % 37 == 0;
+      }
+    BondBasedOperator<2> op_half(disc, mp), op_full(disc, mp);
+    HybridMechanicsParameters hp;
+    hp.sigma        = 0.8;
+    hp.half_stencil = true;
+    HybridBondBasedModel<2> half(op_half, InfluenceFunction::constant, hp, standard);
+    hp.half_stencil = false;
+    HybridBondBasedModel<2> full(op_full, InfluenceFunction::constant, hp, standard);
+    if (!half.uses_lattice_sweep())
+      {
+        if (root())
+          std::cout << "  lattice sweep not compiled (no AVX-512): nothing to compare" << std::endl;
+        return;
+      }
+    MechanicsModel<2>::VectorField u, f, g;
+    half.initialize(u);
+    half.initialize(f);
+    half.initialize(g);
+    for (const double amplitude : {1., 1.6})
+      {
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          {
+            const auto &x = disc.position[i];
+            u[0].local_element(i) =
+              amplitude * (1e-3 * std::sin(0.3 * x[0] + 0.7 * x[1]) + (x[1] > 20.3 ? 3e-2 * x[0] / L : 0.));
+            u[1].local_element(i) = amplitude * 1e-3 * std::cos(0.5 * x[0] - 0.2 * x[1]);
+          }
+        for (auto &v : u)
+          v.update_ghost_values();
+        half.compute_forces(u, f);
+        full.compute_forces(u, g);
+        double       diff = 0., f_max = 0.;
+        unsigned int scheme_differ = 0;
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          {
+            scheme_differ += half.scheme().local_element(i) != full.scheme().local_element(i);
+            for (unsigned int a = 0; a < 2; ++a)
+              {
+                diff  = std::max(diff, std::abs(f[a].local_element(i) - g[a].local_element(i)));
+                f_max = std::max(f_max, std::abs(g[a].local_element(i)));
+              }
+          }
+        diff = Utilities::MPI::max(diff, MPI_COMM_WORLD) / Utilities::MPI::max(f_max, MPI_COMM_WORLD);
+        scheme_differ = Utilities::MPI::sum(scheme_differ, MPI_COMM_WORLD);
+        const auto  &bh = half.broken(), &bf = full.broken();
+        unsigned int flags_differ = Utilities::MPI::sum(unsigned(bh != bf), MPI_COMM_WORLD);
+        PeriDEAL::Vector dh, df;
+        disc.initialize_vector(dh);
+        disc.initialize_vector(df);
+        half.damage(dh);
+        full.damage(df);
+        double damage_diff = 0., damage_max = 0.;
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          {
+            damage_diff = std::max(damage_diff, std::abs(dh.local_element(i) - df.local_element(i)));
+            damage_max  = std::max(damage_max, df.local_element(i));
+          }
+        damage_diff = Utilities::MPI::max(damage_diff, MPI_COMM_WORLD);
+        damage_max  = Utilities::MPI::max(damage_max, MPI_COMM_WORLD);
+        const std::string at = " (amplitude " + std::to_string(amplitude) + ")";
+        check(full.n_standard_nodes() == half.n_standard_nodes() && scheme_differ == 0 &&
+                half.n_switch_events() == full.n_switch_events(),
+              "Omega_s: " + std::to_string(half.n_standard_nodes()) + " nodes, " +
+                std::to_string(half.n_switch_events()) + " switch events, " +
+                std::to_string(scheme_differ) + " nodes differ" + at);
+        check(flags_differ == 0 && half.n_broken_bonds() == full.n_broken_bonds() &&
+                half.n_broken_bonds() > 0,
+              "broken bonds: " + std::to_string(half.n_broken_bonds()) + " (half stencil) / " +
+                std::to_string(full.n_broken_bonds()) + " (full), flags identical" + at);
+        check(damage_diff == 0. && damage_max > 0.,
+              "max |damage difference| = " + sci(damage_diff) + ", max damage " + sci(damage_max) + at);
+        // Sums of up to 50 terms in another order (the PMB forces cancel in
+        // +-xi pairs, so round-off is relative to the bond forces).
+        check(diff <= 1e-12, "half vs full stencil: max |dF| / max |F| = " + sci(diff) + " <= 1e-12" + at);
+      }
   }
 
   std::map<types::particle_index, double>
@@ -426,12 +535,20 @@ namespace
 
   // (c) The same run to 50 us on MPI_COMM_WORLD and on rank 0 alone: the
   // same Omega_s and the same damage per node.
+  // With the full-stencil Omega_s rows and with the half-stencil sweep
+  // (@p half_stencil).
   void
-  rank_invariance()
+  rank_invariance_with(const bool half_stencil)
   {
     const double dx = 2., delta = 8., T = 50e-6;
-    MechanicsSolver<2> dist(MPI_COMM_WORLD,
-                            kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "ri-dist"));
+    const auto   parameters = [&](const std::string &dir) {
+      auto p                = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, dir);
+      p.hybrid.half_stencil = half_stencil;
+      return p;
+    };
+    if (root())
+      std::cout << "  Omega_s rows: " << (half_stencil ? "half" : "full") << " stencil" << std::endl;
+    MechanicsSolver<2> dist(MPI_COMM_WORLD, parameters("ri-dist"));
     dist.run();
     // (id, damage, scheme) of every node, gathered on rank 0.
     std::vector<double> mine;
@@ -448,8 +565,7 @@ namespace
     const auto   events     = dist.hybrid_model()->n_switch_events();
     if (!root())
       return;
-    MechanicsSolver<2> serial(MPI_COMM_SELF,
-                              kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "ri-serial"));
+    MechanicsSolver<2> serial(MPI_COMM_SELF, parameters("ri-serial"));
     serial.run();
     check(events > 0 && n_standard == serial.hybrid_model()->n_standard_nodes(),
           "Omega_s nodes: " + std::to_string(n_standard) + " (distributed, " +
@@ -476,6 +592,13 @@ namespace
     check(scheme_diff == 0, "scheme per node identical (" + std::to_string(scheme_diff) + " differ)");
     // Same bonds broken (bitwise the same stretches): identical damage.
     check(diff == 0., "max |damage_dist - damage_serial| = " + sci(diff));
+  }
+
+  void
+  rank_invariance()
+  {
+    rank_invariance_with(false);
+    rank_invariance_with(true);
   }
 
   void
@@ -516,17 +639,24 @@ namespace
   // (e) Two bond length classes (m = 6.4 > 4: bonds up to 4 dx and longer
   // ones), which test only the bonds of the class whose bound fired: the
   // same run as the every-step test, and fewer bond tests than whole rows.
+  // The KW case of (e) and (g): dx = 1.25, delta = 8 (m = 6.4), to
+  // 87.5 us, output in @p dir; and the same with the every-step test.
+  std::pair<MechanicsRunParameters<2>, MechanicsRunParameters<2>>
+  kw_long_bonds(const std::string &dir, const bool lattice_bound)
+  {
+    auto ph = kalthoff_winkler(1.25, 8., 87.5e-6, "hybrid adaptive", 0.8, dir);
+    ph.hybrid.lattice_bound   = lattice_bound;
+    auto pe                   = ph;
+    pe.hybrid.switching_bound = false;
+    pe.output_directory       = dir + "-every-step";
+    return {ph, pe};
+  }
+
   void
   kw_classes()
   {
-    const double dx = 1.25, delta = 8., T = 87.5e-6;
-    auto         ph = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-classes");
-    ph.hybrid.lattice_bound = false;
-    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph);
-    auto               pe     = ph;
-    pe.hybrid.switching_bound = false;
-    pe.output_directory       = "kw-classes-every-step";
-    MechanicsSolver<2> every(MPI_COMM_SELF, pe);
+    const auto [ph, pe] = kw_long_bonds("kw-classes", false);
+    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph), every(MPI_COMM_SELF, pe);
     hybrid.run();
     every.run();
     // At this coarse lattice (8 x 16 blocks of the long class over the
@@ -550,13 +680,8 @@ namespace
   void
   kw_lattice()
   {
-    const double dx = 1.25, delta = 8., T = 87.5e-6;
-    auto         ph = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-lattice");
-    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph);
-    auto               pe     = ph;
-    pe.hybrid.switching_bound = false;
-    pe.output_directory       = "kw-lattice-every-step";
-    MechanicsSolver<2> every(MPI_COMM_SELF, pe);
+    const auto [ph, pe] = kw_long_bonds("kw-lattice", true);
+    MechanicsSolver<2> hybrid(MPI_COMM_SELF, ph), every(MPI_COMM_SELF, pe);
     auto               pb   = ph;
     pb.hybrid.lattice_bound = false;
     pb.output_directory     = "kw-lattice-budget";
@@ -709,5 +834,6 @@ main(int argc, char **argv)
               {"kw_classes", kw_classes},
               {"kw_lattice", kw_lattice},
               {"kw_equivalence", kw_equivalence},
+              {"half_stencil", half_stencil},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

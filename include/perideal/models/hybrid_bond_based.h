@@ -47,6 +47,18 @@ namespace PeriDEAL
      * exact node tests differs.
      */
     bool lattice_bound = true;
+    /**
+     * In 2D lattice sweeps (uses_lattice_sweep()): evaluate the Omega_s
+     * rows as a half-stencil sweep with reactions (each bond with an owned
+     * Omega_s end once, from its end with the lower box position) instead
+     * of every row over its full stencil (every bond between two Omega_s
+     * nodes twice). The same bonds break; the forces differ by the
+     * round-off of another summation order, which is still independent of
+     * the partition (see sweep_half_rows()). Off by default: 37 % fewer
+     * bond vectors, but each costs ~1.5x (the reaction update), and KW
+     * dx = 0.25 measured no robust gain (doc/benchmarks.md, session 12).
+     */
+    bool half_stencil = false;
   };
 
   /**
@@ -395,6 +407,31 @@ namespace PeriDEAL
     lattice_bound_vectors();
     bool
     sweep_standard_rows(VectorField &force);
+    /**
+     * The Omega_s rows as a half-stencil sweep (HybridMechanicsParameters::
+     * half_stencil): every vector of half_groups, in their order, evaluates
+     * for every positive offset g (in the order of half_offsets) the bonds
+     * (L, L + o_g) of its lanes L for which L or L + o_g is an owned
+     * Omega_s node, sums them in registers (stored to half_acc) and adds
+     * them to half_reaction at L + o_g; F = acc - reaction. The vectors are
+     * the same blocks of lattice rows on every rank (the box starts at a
+     * multiple of 8 in x) and their order is a function of the lattice
+     * (tiles of half_tile columns, row by row), so a row's terms arrive in
+     * an order fixed by the lattice (its own: by g; its reactions: by source
+     * vector, then g), and the forces do not depend on the partition. True
+     * if a bond broke.
+     */
+    bool
+    sweep_half_rows(VectorField &force);
+    /** The per-vector live masks of the half-stencil sweep (half_mask). */
+    void
+    build_half_mask();
+    /**
+     * Clear both live bits and flag the owned CSR copies of the bonds in
+     * sweep_broken; true if there are any.
+     */
+    bool
+    apply_sweep_broken();
     void
     sweep_wls_rows(VectorField &force);
 
@@ -508,6 +545,34 @@ namespace PeriDEAL
      */
     std::vector<std::uint32_t> standard_start;
     std::vector<std::uint8_t>  standard_start_lanes;
+    /**
+     * The half-stencil Omega_s sweep (sweep_half_rows()): on; the positive
+     * full offsets (by x offset, then y offset); per vector (with spare
+     * zero vectors up to the stencil reach), the lanes of owned Omega_s
+     * nodes; the vectors that hold the lower end of a bond with an owned
+     * Omega_s end (by tile, then box order) and those with owned Omega_s
+     * lanes; reactions and own sums over the box (layout of sweep_p); the
+     * tile width in lattice columns.
+     */
+    bool                         half_on = false;
+    std::vector<unsigned int>    half_offsets;
+    std::vector<std::uint8_t>    standard_lanes;
+    std::vector<std::uint32_t>   half_groups, standard_vectors;
+    std::vector<double>          half_reaction, half_acc;
+    static constexpr std::int64_t half_tile = 64;
+    /**
+     * Per slot h of half_offsets: the offset and k, k r, (r + s0 r)^2; per
+     * full offset its slot (or -1); per vector its index in half_groups (or
+     * -1); per vector of half_groups and slot the lanes whose bond is
+     * evaluated (rebuilt after a change of scheme or of the live bits, bits
+     * of broken bonds cleared), and whether it is up to date; scratch:
+     * the lanes broken per slot in one vector.
+     */
+    std::vector<std::int64_t>          half_o;
+    std::vector<std::array<double, 3>> half_constants;
+    std::vector<int>                   half_slot, half_index;
+    std::vector<std::uint8_t>          half_mask, half_broken_lanes;
+    bool                               half_mask_valid = false;
     /** Bonds broken by the sweep: (full offset, box position of the row). */
     std::vector<std::pair<unsigned int, std::uint32_t>> sweep_broken;
     /** The shared WLS pattern: linear and lattice offsets, weights; per owned node: uses it. */

@@ -292,9 +292,12 @@ namespace PeriDEAL
     setup();
     void
     update_accelerations();
-    /** Held-velocity nodes get v(x, @p time). */
+    /** The owned nodes with a prescribed velocity (increasing). */
+    std::vector<unsigned int>
+    velocity_held_nodes() const;
+    /** The held-velocity nodes @p nodes (velocity_held_nodes()) get v(x, @p time). */
     void
-    apply_prescribed_velocities(const double time);
+    apply_prescribed_velocities(const double time, const std::vector<unsigned int> &nodes);
 
     /** The adapter of the BondBasedOperator constructor (declared before model). */
     std::unique_ptr<MechanicsModel<dim>> owned_model;
