@@ -299,6 +299,8 @@ namespace
     check(radius(Fem::WaveBoundary::first_order, 0.) <= 1., "first-order ABC: radius <= 1");
     // Measured 1.0025 (growth 0.12 per unit time, frequency ~3.9 rad per unit
     // time, a mesh-scale boundary mode); the cloud guards hold all the same.
+    // Session 13: a tangential sawtooth on the edges, removed by the layer
+    // (verlet_layer_spectral_radius).
     const double rho = radius(Fem::WaveBoundary::absorbing, 0.);
     check(rho > 1. + 1e-4, "EBF (full pseudo-inverse): weakly unstable, radius " + sci(rho - 1.) + " above 1 (known)");
     // A truncated pseudo-inverse (relative cutoff 2e-3) is stable: the
