@@ -15,6 +15,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace PeriDEAL
 {
@@ -80,6 +81,69 @@ namespace PeriDEAL
 
       for (auto *x : {&u, &v, &a, &Ku, &u_star, &v_star, &rhs, &tmp})
         x->reinit(part);
+      check_parameter(prm.layer_viscosity >= 0. && (prm.layer_viscosity == 0. || !newmark),
+                      "FEM/Layer viscosity", prm.layer_viscosity, ">= 0 (> 0: velocity Verlet only)");
+      if (prm.layer_viscosity > 0.)
+        {
+          check_parameter(prm.layer_width >= 1, "FEM/Layer width", prm.layer_width, ">= 1");
+          // Graph distance of the DoFs from the boundary, ring by ring: a
+          // DoF joins when a stiffness coupling reaches the marked set (the
+          // marked entries are all 1 and the couplings of a Q1/Q2 Laplacian
+          // row to its neighbours do not cancel at the front).
+          const int          first = type == WaveBoundary::first_order ? 0 : 1;
+          const int          width = static_cast<int>(prm.layer_width);
+          const unsigned int n     = near_field.n_owned();
+          DistributedVector  marked(part), front(part), depth(part);
+          depth = -1.;
+          for (const unsigned int i : boundary_dofs)
+            {
+              depth.local_element(i)  = 0.;
+              marked.local_element(i) = 1.;
+            }
+          for (int r = 1; r < width + first; ++r)
+            {
+              marked.update_ghost_values();
+              stiffness.vmult(front, marked);
+              for (unsigned int i = 0; i < n; ++i)
+                if (depth.local_element(i) < 0. && front.local_element(i) != 0.)
+                  depth.local_element(i) = r;
+              for (unsigned int i = 0; i < n; ++i)
+                marked.local_element(i) = depth.local_element(i) >= 0. ? 1. : 0.;
+            }
+          depth.update_ghost_values();
+          // Ring Laplacian: sum over the couplings (i, j) of the stiffness
+          // with depth(i) = depth(j) = r of sigma_r |K_ij| (e_i - e_j)
+          // (e_i - e_j)^T, sigma_r = 1 - (r - first) / width for
+          // first <= r < first + width. Only couplings within a ring, i.e.
+          // along the boundary: a field varying only along the normal is
+          // not seen at all, a tangentially smooth one weakly (k_t h)^2,
+          // the tangential sawtooth of the backward-wave branch strongly.
+          // Positive semi-definite; with prescribed boundary DoFs (first =
+          // 1) it couples free DoFs only.
+          near_field.reinit_matrix(layer_matrix);
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              const int r = static_cast<int>(depth.local_element(i));
+              if (r < first || r >= first + width)
+                continue;
+              const double                  sigma = 1. - static_cast<double>(r - first) / width;
+              const types::global_dof_index gi    = near_field.ids[i];
+              for (auto it = stiffness.begin(gi); it != stiffness.end(gi); ++it)
+                if (it->column() != gi && depth(it->column()) == r)
+                  {
+                    const double c = sigma * std::abs(it->value());
+                    layer_matrix.add(gi, gi, c);
+                    layer_matrix.add(gi, it->column(), -c);
+                  }
+            }
+          layer_matrix.compress(VectorOperation::add);
+          layer_v.reinit(part);
+          layer_force.reinit(part);
+          has_layer = true;
+        }
+      check_parameter(prm.layer_order == 1 || prm.layer_order == 2, "FEM/Layer order", prm.layer_order, "1 or 2");
+      layer_order = prm.layer_order;
+      layer_eta   = prm.layer_viscosity * chi * std::pow(spacing, 2 * prm.layer_order - 1);
       VectorTools::interpolate(dof_handler, initial, u);
       if (type == WaveBoundary::dirichlet)
         for (const unsigned int i : boundary_dofs)
@@ -237,9 +301,11 @@ namespace PeriDEAL
       u.update_ghost_values();
       stiffness.vmult(Ku, u);
       const unsigned int n = near_field.n_owned();
+      apply_layer_viscosity();
       for (unsigned int i = 0; i < n; ++i)
         tmp.local_element(i) = -chi * chi * Ku.local_element(i) -
-                               chi * boundary_mass.local_element(i) * (v.local_element(i) + d * u.local_element(i));
+                               chi * boundary_mass.local_element(i) * (v.local_element(i) + d * u.local_element(i)) -
+                               (has_layer ? layer_force.local_element(i) : 0.);
       if (lumped)
         for (unsigned int i = 0; i < n; ++i)
           a.local_element(i) = tmp.local_element(i) / mass.local_element(i);
@@ -247,6 +313,27 @@ namespace PeriDEAL
         mass_solver->solve(a, tmp);
       a.add(-2. * d, v);
       v.update_ghost_values();
+    }
+
+    template <int dim>
+    void
+    FemWave<dim>::apply_layer_viscosity()
+    {
+      if (!has_layer)
+        return;
+      // L positive semi-definite: v . (eta L v) >= 0 and v . (eta L M^-1 L v) >= 0.
+      for (unsigned int i = 0; i < near_field.n_owned(); ++i)
+        layer_v.local_element(i) = v.local_element(i);
+      layer_v.update_ghost_values();
+      layer_matrix.vmult(layer_force, layer_v);
+      for (unsigned int k = 1; k < layer_order; ++k)
+        {
+          for (unsigned int i = 0; i < near_field.n_owned(); ++i)
+            layer_v.local_element(i) = layer_force.local_element(i) / mass.local_element(i);
+          layer_v.update_ghost_values();
+          layer_matrix.vmult(layer_force, layer_v);
+        }
+      layer_force *= layer_eta;
     }
 
     template <int dim>
@@ -373,11 +460,17 @@ namespace PeriDEAL
           u.local_element(i) = 0.;
       u.update_ghost_values();
       stiffness.vmult(Ku, u);
-      // M a = -chi^2 K u - 2 d M v - chi B (v + d u); B = 0 unless first order.
+      // The layer force from v^{n+1/2} (explicit).
+      apply_layer_viscosity();
+      // M a = -chi^2 K u - 2 d M v - chi B (v + d u) (- the layer force of v^{n+1/2}
+      // in the layer); B = 0 unless first order.
       for (unsigned int i = 0; i < n; ++i)
         {
           const double b = chi * boundary_mass.local_element(i) / mass.local_element(i);
-          const double f = -chi * chi * Ku.local_element(i) / mass.local_element(i) - b * d * u.local_element(i);
+          const double f = -(chi * chi * Ku.local_element(i) +
+                             (has_layer ? layer_force.local_element(i) : 0.)) /
+                             mass.local_element(i) -
+                           b * d * u.local_element(i);
           v.local_element(i) = (v.local_element(i) + half * f) / (1. + dt * d + half * b);
           a.local_element(i) = f - (2. * d + b) * v.local_element(i);
         }

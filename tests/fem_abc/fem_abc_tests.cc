@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <memory>
 #include <sstream>
 
@@ -188,6 +189,32 @@ namespace
   }
 
   /**
+   * E13 as in e13_curved() with the tangential viscous layer of session 13
+   * (layer_viscosity 0.2: one-step radius 1, energy non-increasing over
+   * 1e6 steps; verlet_layer_spectral_radius, verlet_energy_decay_long). The
+   * reference and the first-order run get the same layer.
+   */
+  void
+  e13_verlet_layer()
+  {
+    E13 c                  = e13_default();
+    c.fem.layer_viscosity  = 0.2;
+    c.abc.curvature_radius = 64.;
+    const E13Result r      = run_e13(c, true);
+    // Measured: energy 4.28e-4 vs 5.12e-3 (12.0x), probe 3.99e-4 vs
+    // 7.24e-3 (18x), field at t_end 1.26e-3 vs 8.94e-3 (7.1x; without the
+    // layer 8.9x, the cost of stability). Plane modes with the layer:
+    // 4.60e-4 (11.1x), 2.96e-4 (24x), 1.99e-3 (4.5x). Margins ~15-20 %.
+    check(r.energy_ebf * 10. < r.energy_first,
+          "layer: max |E - E_ref|/E0 EBF " + sci(r.energy_ebf) + " at least 10x below first-order " +
+            sci(r.energy_first));
+    check(r.probe_ebf * 15. < r.probe_first,
+          "layer: probe EBF " + sci(r.probe_ebf) + " at least 15x below first-order " + sci(r.probe_first));
+    check(r.final_ebf * 6. < r.final_first,
+          "layer: field at t_end EBF " + sci(r.final_ebf) + " at least 6x below first-order " + sci(r.final_first));
+  }
+
+  /**
    * E13 as in e13() with implicit Newmark and consistent mass (local
    * relation: the discrete one is the lumped-mass symbol); the extended
    * reference and the first-order run use the same integrator and mass.
@@ -241,9 +268,10 @@ namespace
 
   double
   radius(const Fem::WaveBoundary bc, const double tolerance, const unsigned int degree = 1,
-         const std::string &scheme = "velocity Verlet", const bool lumped = true)
+         const std::string &scheme = "velocity Verlet", const bool lumped = true, const E13 &base = e13_default(),
+         const unsigned int n_cells = 12)
   {
-    E13 c                        = e13_default();
+    E13 c                        = base;
     c.fem.scheme                 = scheme;
     c.fem.lumped_mass            = lumped;
     if (!lumped) // the discrete relation is the lumped-mass symbol
@@ -253,11 +281,11 @@ namespace
     c.fem.time_step              = c.dt;
     const ScalarFunctionFromFunctionObject<2> u0(pulse);
     Triangulation<2>                          tria;
-    GridGenerator::subdivided_hyper_cube(tria, 12, -3., 3.);
+    GridGenerator::subdivided_hyper_cube(tria, n_cells, -3., 3.);
     Fem::FemWave<2>      w(tria, c.fem, bc, c.abc, u0);
     unsigned int         n_up = 0;
     std::complex<double> dom;
-    const double         rho = w.one_step_spectral_radius(2000, &n_up, &dom);
+    const double         rho = w.one_step_spectral_radius(4000, &n_up, &dom);
     if (root())
       std::cout << "    spectral radius 1 + " << sci(rho - 1.) << " (" << n_up << " > 1, dominant " << dom << ")" << std::endl;
     return rho;
@@ -271,6 +299,8 @@ namespace
     check(radius(Fem::WaveBoundary::first_order, 0.) <= 1., "first-order ABC: radius <= 1");
     // Measured 1.0025 (growth 0.12 per unit time, frequency ~3.9 rad per unit
     // time, a mesh-scale boundary mode); the cloud guards hold all the same.
+    // Session 13: a tangential sawtooth on the edges, removed by the layer
+    // (verlet_layer_spectral_radius).
     const double rho = radius(Fem::WaveBoundary::absorbing, 0.);
     check(rho > 1. + 1e-4, "EBF (full pseudo-inverse): weakly unstable, radius " + sci(rho - 1.) + " above 1 (known)");
     // A truncated pseudo-inverse (relative cutoff 2e-3) is stable: the
@@ -504,12 +534,8 @@ namespace
    * samples 1.3e-20 E0: no growth over 1e6 steps.
    */
   void
-  newmark_energy_decay(const unsigned int n_steps, const unsigned int every)
+  energy_decay(E13 c, const unsigned int n_steps, const unsigned int every)
   {
-    E13 c             = e13_default();
-    c.fem.scheme      = "Newmark";
-    c.fem.lumped_mass = false;
-    c.abc.dispersion  = "local";
     c.fem.time_step   = c.dt;
     const ScalarFunctionFromFunctionObject<2> u0(
       [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
@@ -543,16 +569,86 @@ namespace
     check(max_after < 1e-12, "no growth: energy over the second half " + sci(max_after) + " E0 < 1e-12 E0");
   }
 
+  E13
+  newmark_consistent()
+  {
+    E13 c             = e13_default();
+    c.fem.scheme      = "Newmark";
+    c.fem.lumped_mass = false;
+    c.abc.dispersion  = "local";
+    return c;
+  }
+
   void
   newmark_energy_decay_short()
   {
-    newmark_energy_decay(20000, 100);
+    energy_decay(newmark_consistent(), 20000, 100);
   }
 
   void
   newmark_energy_decay_long()
   {
-    newmark_energy_decay(1000000, 1000);
+    energy_decay(newmark_consistent(), 1000000, 1000);
+  }
+
+  /** The E13 set-up (velocity Verlet, lumped mass, discrete relation) with the tangential layer of session 13. */
+  E13
+  verlet_layer(const double curvature_radius = 0.)
+  {
+    E13 c                  = e13_default();
+    c.fem.layer_viscosity  = 0.2;
+    c.abc.curvature_radius = curvature_radius;
+    return c;
+  }
+
+  /**
+   * Long-run stability with velocity Verlet + lumped mass + EBF and the
+   * tangential viscous layer (FemWaveParameters::layer_viscosity = 0.2),
+   * same near field, pulse and checks as the Newmark run above, plane and
+   * curved (rho 64) modes.
+   */
+  void
+  verlet_energy_decay_short()
+  {
+    energy_decay(verlet_layer(), 20000, 100);
+    energy_decay(verlet_layer(64.), 20000, 100);
+  }
+
+  void
+  verlet_energy_decay_long()
+  {
+    energy_decay(verlet_layer(), 1000000, 1000);
+  }
+
+  /**
+   * One-step spectral radius of velocity Verlet + lumped mass + EBF on
+   * (-3, 3)^2 (as in spectral_radius) with the tangential viscous layer.
+   * Without it: 1 + 2.5e-3, the dominant eigenvector a tangential sawtooth
+   * at the edges, decaying inward over ~3 rings (doc/design.md, session 13).
+   */
+  void
+  verlet_layer_spectral_radius()
+  {
+    for (const double rho : {0., 64.})
+      {
+        const std::string modes = rho > 0. ? "curved modes rho 64" : "plane modes";
+        const double      r     = radius(Fem::WaveBoundary::absorbing, 0., 1, "velocity Verlet", true, verlet_layer(rho));
+        check(r <= 1. + 1e-10, "Verlet + lumped + EBF + layer 0.2, " + modes + ": radius 1 + " + sci(r - 1.) +
+                                 " <= 1 + 1e-10");
+      }
+    // The layer only dissipates: Dirichlet and first-order stay stable.
+    for (const auto bc : {Fem::WaveBoundary::dirichlet, Fem::WaveBoundary::first_order})
+      check(radius(bc, 0., 1, "velocity Verlet", true, verlet_layer()) <= 1. + 1e-10,
+            "layer with a non-absorbing boundary: radius <= 1 + 1e-10");
+    // Measured threshold: layer 0.1 leaves 1 + 1.5e-4 (8 eigenvalues > 1),
+    // 0.15 gives 1; first order (L instead of L M^-1 L) needs 0.3.
+    E13 weak                   = verlet_layer();
+    weak.fem.layer_viscosity   = 0.1;
+    check(radius(Fem::WaveBoundary::absorbing, 0., 1, "velocity Verlet", true, weak) > 1. + 1e-5,
+          "layer 0.1: still weakly unstable (the test can fail)");
+    // Finer mesh (h = 0.25, (-3, 3)^2): the scaled viscosity carries over.
+    check(radius(Fem::WaveBoundary::absorbing, 0., 1, "velocity Verlet", true, verlet_layer(), 24) <= 1. + 1e-10,
+          "h = 0.25: radius <= 1 + 1e-10");
   }
 
   // Exploratory (not registered): E13_SCAN="key=value ...; ..." runs of E13
@@ -574,6 +670,9 @@ namespace
         c.L            = num("L", c.L);
         c.t_end        = num("T", c.t_end);
         c.dt           = num("dt", c.dt);
+        c.fem.layer_viscosity = num("eta", 0.);
+        c.fem.layer_width     = static_cast<unsigned int>(num("width", 3));
+        c.fem.layer_order     = static_cast<unsigned int>(num("order", 2));
         if (kv.count("newmark"))
           {
             c.fem.scheme      = "Newmark";
@@ -602,6 +701,120 @@ namespace
         catch (std::exception &e)
           {
             std::cout << "  exception: " << e.what() << std::endl;
+          }
+      }
+  }
+
+  // Exploratory (not registered): MODE_SCAN="key=value ...; ..." power
+  // iteration of the Verlet + lumped one-step map on (-N h, N h)^2 from rough
+  // data; prints the growth per step and where the dominant mode lives
+  // (rms of u over one period, per DoF, as a grid, normalized to its max).
+  void
+  mode_scan()
+  {
+    const char        *env = std::getenv("MODE_SCAN");
+    std::istringstream runs(env ? env : "");
+    std::string        run;
+    while (std::getline(runs, run, ';'))
+      {
+        const auto kv  = key_values(run);
+        const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv.at(k)) : def; };
+        E13        c   = e13_default();
+        c.abc          = with_wave_settings(c.abc, kv);
+        c.fem.time_step = num("dt", c.dt);
+        c.fem.extrapolate_velocity = num("xv", 0) != 0;
+        c.fem.preserve_constants   = num("pc", 1) != 0;
+        c.fem.layer_viscosity      = num("eta", 0.);
+        c.fem.layer_width          = static_cast<unsigned int>(num("width", 3));
+        c.fem.layer_order          = static_cast<unsigned int>(num("order", 2));
+        const unsigned int N = static_cast<unsigned int>(num("N", 12)), steps = static_cast<unsigned int>(num("steps", 20000));
+        const double L = 0.25 * N;
+        std::cout << "[" << run << "]" << std::endl;
+        class Rough : public Function<2>
+        {
+        public:
+          double
+          value(const Point<2> &p, const unsigned int = 0) const override
+          {
+            const double v = std::sin(12.9898 * p[0] + 78.233 * p[1] + 0.5) * 43758.5453;
+            return 2. * (v - std::floor(v)) - 1.;
+          }
+        } rough;
+        Triangulation<2> tria;
+        GridGenerator::subdivided_hyper_cube(tria, N, -L, L);
+        Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, rough);
+        if (num("rho", 0) != 0)
+          {
+            unsigned int         n_up = 0;
+            std::complex<double> dom;
+            const double         r = w.one_step_spectral_radius(4000, &n_up, &dom);
+            std::cout << "  rho - 1 = " << sci(r - 1.) << " (" << n_up << " up, dominant " << dom << ")" << std::endl;
+          }
+        const auto norm = [&]() { return w.solution().l2_norm(); };
+        double     n0 = norm(), log_growth = 0.;
+        for (unsigned int s = 1; s <= steps; ++s)
+          {
+            w.advance();
+            if (s % 100 == 0)
+              {
+                const double n1 = norm();
+                if (s > steps / 2)
+                  log_growth += std::log(n1 / n0);
+                n0 = n1;
+              }
+          }
+        std::cout << "  growth per step (second half) " << sci(std::exp(log_growth / (steps / 2)) - 1.) << std::endl;
+        const auto        &nf = w.layout();
+        std::vector<double> rms(nf.points.size(), 0.);
+        for (unsigned int s = 0; s < 400; ++s)
+          {
+            w.advance();
+            for (unsigned int i = 0; i < rms.size(); ++i)
+              rms[i] += w.solution().local_element(i) * w.solution().local_element(i);
+          }
+        double mx = 0.;
+        for (double &x : rms)
+          mx = std::max(mx, x = std::sqrt(x));
+        std::vector<std::vector<double>> grid(N + 1, std::vector<double>(N + 1, 0.));
+        for (unsigned int i = 0; i < rms.size(); ++i)
+          {
+            const int ix = static_cast<int>(std::round((nf.points[i][0] + L) * N / (2. * L)));
+            const int iy = static_cast<int>(std::round((nf.points[i][1] + L) * N / (2. * L)));
+            grid[iy][ix] = rms[i] / mx;
+          }
+        {
+          // Snapshot of the middle column (signs: the normal structure).
+          std::vector<double> col(N + 1, 0.);
+          for (unsigned int i = 0; i < rms.size(); ++i)
+            if (std::abs(nf.points[i][0] - (kv.count("x") ? std::stod(kv.at("x")) : 0.)) < 1e-9)
+              col[static_cast<int>(std::round((nf.points[i][1] + L) * N / (2. * L)))] = w.solution().local_element(i);
+          std::cout << "  column snapshot (top to bottom):";
+          for (int iy = N; iy >= 0; --iy)
+            std::cout << " " << std::setprecision(2) << col[iy] / w.solution().linfty_norm();
+          std::cout << std::endl;
+          std::vector<double> row(N + 1, 0.), row1(N + 1, 0.);
+          for (unsigned int i = 0; i < rms.size(); ++i)
+            {
+              const int ix = static_cast<int>(std::round((nf.points[i][0] + L) * N / (2. * L)));
+              if (std::abs(nf.points[i][1] - L) < 1e-9)
+                row[ix] = w.solution().local_element(i);
+              if (std::abs(nf.points[i][1] - L + 2. * L / N) < 1e-9)
+                row1[ix] = w.solution().local_element(i);
+            }
+          std::cout << "  top row snapshot:";
+          for (unsigned int ix = 0; ix <= N; ++ix)
+            std::cout << " " << std::setprecision(2) << row[ix] / w.solution().linfty_norm();
+          std::cout << std::endl << "  second row snapshot:";
+          for (unsigned int ix = 0; ix <= N; ++ix)
+            std::cout << " " << std::setprecision(2) << row1[ix] / w.solution().linfty_norm();
+          std::cout << std::endl;
+        }
+        for (int iy = N; iy >= 0; --iy)
+          {
+            std::cout << "  ";
+            for (unsigned int ix = 0; ix <= N; ++ix)
+              std::cout << std::setw(5) << std::fixed << std::setprecision(2) << grid[iy][ix];
+            std::cout << std::defaultfloat << std::endl;
           }
       }
   }
@@ -776,5 +989,5 @@ namespace
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"e13", e13}, {"e13_curved", e13_curved}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"half_derivative", half_derivative}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}});
 }

@@ -13,3 +13,9 @@ perideal_add_test(NAME fem_abc.newmark_e13 COMMAND $<TARGET_FILE:fem_abc_tests> 
 # 2e4 steps in CI, 1e6 steps (issue 4) in the long test.
 perideal_add_test(NAME fem_abc.newmark_energy_decay COMMAND $<TARGET_FILE:fem_abc_tests> newmark_energy_decay_short LABELS unit)
 perideal_add_test(NAME fem_abc.newmark_energy_decay_long COMMAND $<TARGET_FILE:fem_abc_tests> newmark_energy_decay_long LABELS long TIMEOUT 3000)
+# Velocity Verlet + lumped mass + EBF with the tangential viscous layer
+# (session 13): one-step radius <= 1, energy decay (CI) and 1e6 steps (long).
+perideal_add_test(NAME fem_abc.verlet_layer_spectral_radius COMMAND $<TARGET_FILE:fem_abc_tests> verlet_layer_spectral_radius LABELS unit)
+perideal_add_test(NAME fem_abc.verlet_energy_decay COMMAND $<TARGET_FILE:fem_abc_tests> verlet_energy_decay_short LABELS unit)
+perideal_add_test(NAME fem_abc.verlet_energy_decay_long COMMAND $<TARGET_FILE:fem_abc_tests> verlet_energy_decay_long LABELS long TIMEOUT 3000)
+perideal_add_test(NAME fem_abc.e13_verlet_layer COMMAND $<TARGET_FILE:fem_abc_tests> e13_verlet_layer LABELS convergence)

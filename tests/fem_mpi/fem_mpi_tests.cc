@@ -267,6 +267,12 @@ namespace
               300);
     wave_case("square Q1 lumped Verlet first-order", square(4., 16), fp, Fem::WaveBoundary::first_order,
               e13_abc("discrete"), 300);
+    // The tangential viscous layer of session 13 (ring depths and the ring
+    // Laplacian across the partition).
+    fp.layer_viscosity = 0.2;
+    wave_case("square Q1 lumped Verlet EBF, tangential layer", square(4., 16), fp, Fem::WaveBoundary::absorbing,
+              e13_abc("discrete"), 300);
+    fp.layer_viscosity = 0.;
     fp.scheme      = "Newmark";
     fp.lumped_mass = false;
     wave_case("square Q1 consistent Newmark EBF", square(4., 16), fp, Fem::WaveBoundary::absorbing, e13_abc("local"),

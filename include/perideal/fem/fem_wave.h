@@ -60,6 +60,34 @@ namespace PeriDEAL
        * in E13 (measured), which makes the energy (4.99) meaningless.
        */
       bool extrapolate_velocity = false;
+      /**
+       * Tangential viscosity of a boundary layer (velocity Verlet only; 0,
+       * the default: off, the source's scheme). The force -eta L (M^-1 L)^(o
+       * - 1) v, o = layer_order, eta = layer_viscosity chi h^(2 o - 1) (h the
+       * node spacing), L the ring Laplacian: sum over the stiffness
+       * couplings (i, j) with g_i = g_j = r of sigma_r |K_ij| (e_i - e_j)
+       * (e_i - e_j)^T, g the graph distance from the boundary (in stiffness
+       * couplings), sigma_r = 1 - (r - r_0) / layer_width on the rings
+       * r_0 <= r < r_0 + layer_width, r_0 = 1 when the boundary DoFs are
+       * prescribed (EBF, Dirichlet), 0 with the first-order ABC. L is
+       * positive semi-definite and couples free DoFs only, so the term only
+       * dissipates; it couples DoFs along the boundary only, so a field
+       * varying along the normal is not damped at all and a tangentially
+       * smooth one as (k_t h)^(2 o). Why: with lumped mass the Q1 scheme has
+       * a backward-wave branch at the tangential Nyquist wave number
+       * (omega^2 = (10/3 + 2/3 cos(kappa h)) chi^2 / h^2 on a uniform square
+       * mesh, omega falling with the normal wave number kappa), on which the
+       * EBF extrapolation, outgoing in phase, is incoming in energy: the
+       * one-step radius 1.0025 on squares, the dominant eigenvector a
+       * tangential sawtooth at the edges (doc/design.md, session 13).
+       * layer_viscosity 0.2 (o = 2, width 3) makes the radius 1 on the
+       * measured squares (h = 0.5 and 0.25, dt = 0.02; threshold ~0.15).
+       */
+      double layer_viscosity = 0.;
+      /** Width of the viscous layer in DoF rings. */
+      unsigned int layer_width = 3;
+      /** Order o of the layer operator: 1 (L) or 2 (L M^-1 L, more selective). */
+      unsigned int layer_order = 2;
     };
 
     /** Treatment of the truncation boundary of the FEM near field. */
@@ -192,7 +220,12 @@ namespace PeriDEAL
       std::vector<double>        constant_defect;
       WaveBoundary               type;
       bool                       extrapolate_velocity, lumped, newmark;
-      double                     chi, d, dt, t = 0.;
+      /** The viscous layer: L, a copy of v and the layer force. */
+      bool                           has_layer = false;
+      TrilinosWrappers::SparseMatrix layer_matrix;
+      DistributedVector              layer_v, layer_force;
+      double                     chi, d, dt, t = 0., layer_eta = 0.;
+      unsigned int               layer_order = 1;
 
       /** a from the current u, v (what advance() leaves at every non-boundary DoF). */
       void
@@ -202,6 +235,9 @@ namespace PeriDEAL
       apply_mass(const DistributedVector &x, DistributedVector &y) const;
       void
       advance_verlet();
+      /** layer_force = eta L (M^-1 L)^(o - 1) v (nothing without a layer). */
+      void
+      apply_layer_viscosity();
       void
       advance_newmark();
       /** u^{n+1} of the absorbing DoFs from the cloud data of level n, n-1 (then level n becomes n-1). */
