@@ -130,6 +130,18 @@ namespace PeriDEAL
        * its whole cloud, which no convex combination can.
        */
       std::string fit_form = "value";
+      /**
+       * Curved modes (2D/3D, cloud fits): the radius rho of the outgoing
+       * fronts at the boundary (0: plane modes exp(k d.x), the source). With
+       * rho > 0 every mode is evaluated in the coordinates about the centre
+       * x_i - rho n, s = (r - rho) n + rho theta t (r the distance to the
+       * centre, theta the angle from n, t the tangential direction), times
+       * the amplitude (rho/r)^{(dim-1)/2}: the normal modes are then the
+       * exact outgoing spherical solutions (rho/r) exp(k (r - rho) + D k^2 t)
+       * in 3D and their WKB form sqrt(rho/r) exp(k (r - rho)) in 2D
+       * (e.g. rho = R on a ball near field centred at the source).
+       */
+      double curvature_radius = 0.;
 
       static void
       declare_parameters(ParameterHandler &prm);
