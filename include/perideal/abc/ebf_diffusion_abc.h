@@ -53,7 +53,13 @@ namespace PeriDEAL
        * sum_j V_j = 1 (the constant far field is kept exactly). With a
        * monotone near field (forward Euler at dt <= 1 / max row sum) every
        * row of the one-step map is then a convex combination, so
-       * max_i |C_i| cannot grow: stable for every cloud shape.
+       * max_i |C_i| cannot grow: stable for every cloud shape. "sink"
+       * (Imposed = value): nonnegative least squares without the equality,
+       * V_j >= 0 and sum_j V_j <= 1 (scaled down if the fit exceeds 1): the
+       * same max principle, but the value can fall below every value of its
+       * cloud, which a convex combination cannot (a curved boundary whose
+       * values rise inward while they fall in time). A constant far field
+       * is not preserved (sum_j V_j < 1 drains it).
        */
       std::string fit = "least squares";
       /**
