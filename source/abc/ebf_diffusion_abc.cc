@@ -209,6 +209,9 @@ namespace PeriDEAL
       prm.declare_entry("Boundary curvature", "0", Patterns::Double(0.),
                         "Imposed = half derivative: sum of the principal curvatures of the truncation "
                         "boundary (2/R for a sphere, 1/R for a circle, 0 for flat faces).");
+      prm.declare_entry("Boundary curvature from mesh", "false", Patterns::Bool(),
+                        "Imposed = half derivative (FEM): estimate the curvature per boundary DoF from "
+                        "the adjacent boundary faces' normals instead of Boundary curvature.");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
@@ -250,6 +253,7 @@ namespace PeriDEAL
       fit_form                 = prm.get("Fit form");
       boundary_curvature       = prm.get_double("Boundary curvature");
       curvature_radius         = prm.get_double("Curvature radius");
+      curvature_from_mesh      = prm.get_bool("Boundary curvature from mesh");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
       check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
                         fit == "stabilized" || fit == "sink",

@@ -95,6 +95,12 @@ namespace PeriDEAL
        * constant set by Delta k; here the rate follows the field's history.
        */
       double boundary_curvature = 0.;
+      /**
+       * Imposed = "half derivative" (FEM): instead of boundary_curvature,
+       * the curvature per boundary DoF estimated from the mesh
+       * (Fem::NearFieldLayout::curvatures, clipped at 0).
+       */
+      bool curvature_from_mesh = false;
       /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
       double lower_bound = -1.;
       /**
