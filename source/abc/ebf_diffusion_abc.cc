@@ -130,6 +130,22 @@ namespace PeriDEAL
       }
 
       /**
+       * min |V M - psi| subject to V_j >= 0 only (nonnegative least
+       * squares), scaled down to sum_j V_j = 1 if it exceeds 1: a
+       * sub-stochastic update, so that C_i^{n+1} can fall below every value
+       * of its cloud (a sink), while sum_j |V_j| <= 1 keeps the max
+       * principle of the monotone fit.
+       */
+      Eigen::RowVectorXd
+      sink_fit(const Eigen::MatrixXd &M, const Eigen::RowVectorXd &psi)
+      {
+        Eigen::RowVectorXd V = nonnegative_least_squares(M.transpose(), psi.transpose()).transpose();
+        if (V.sum() > 1.)
+          V /= V.sum();
+        return V;
+      }
+
+      /**
        * The monotone normal derivative at cloud point 0 (the absorbing
        * point): dC/dn = sum_{j != 0} P_j (C_j - C_0) - q C_0 with P_j, q >= 0
        * fitted to @p psi (the modes' normal derivatives) by nonnegative least
@@ -171,12 +187,13 @@ namespace PeriDEAL
       prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
                         "Guard on max_j |V_j|.");
       prm.declare_entry("Updating vector fit", "least squares",
-                        Patterns::Selection("least squares|monotone|bounded|stabilized"),
+                        Patterns::Selection("least squares|monotone|bounded|stabilized|sink"),
                         "least squares: V = Psi M^+ (4.31); monotone: least squares with V_j >= 0, "
                         "sum V_j = 1 (stable for any cloud shape); bounded: least squares with "
                         "sum V_j = 1, sum |V_j| <= 1 + l1 excess, V_j >= -lower bound; stabilized "
                         "(PD): per cloud (1 - theta) least squares + theta monotone, theta raised "
-                        "on the clouds of growing modes until the one-step map is stable.");
+                        "on the clouds of growing modes until the one-step map is stable; sink: "
+                        "least squares with V_j >= 0, sum V_j <= 1 (the value can fall below its cloud).");
       prm.declare_entry("Updating vector l1 excess", "0.5", Patterns::Double(0.),
                         "bounded fit: sum_j |V_j| <= 1 + this (0: the monotone fit).");
       prm.declare_entry("Updating vector lower bound", "-1", Patterns::Double(),
@@ -192,6 +209,9 @@ namespace PeriDEAL
       prm.declare_entry("Boundary curvature", "0", Patterns::Double(0.),
                         "Imposed = half derivative: sum of the principal curvatures of the truncation "
                         "boundary (2/R for a sphere, 1/R for a circle, 0 for flat faces).");
+      prm.declare_entry("Boundary curvature from mesh", "false", Patterns::Bool(),
+                        "Imposed = half derivative (FEM): estimate the curvature per boundary DoF from "
+                        "the adjacent boundary faces' normals instead of Boundary curvature.");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
@@ -202,6 +222,10 @@ namespace PeriDEAL
                         "value (4.31): V = Psi(0, dt) M^+; increment (least squares or stabilized "
                         "fit, Imposed = value): V = e_i + (Psi(0, dt) - Psi(0, 0)) M^+, the old value "
                         "plus the extrapolated change.");
+      prm.declare_entry("Curvature radius", "0", Patterns::Double(0.),
+                        "2D/3D cloud fits: radius rho of the outgoing fronts at the boundary (0: plane "
+                        "modes, the source); rho > 0: modes in the coordinates about x_i - rho n with the "
+                        "amplitude (rho/r)^((dim-1)/2) (exact spherical modes in 3D).");
       prm.declare_entry("Stability check steps", "200", Patterns::Integer(0),
                         "PD near field: power iteration of the one-step map over this many steps "
                         "at setup; growth stops the setup naming the cloud (0: off).");
@@ -228,11 +252,13 @@ namespace PeriDEAL
       pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
       fit_form                 = prm.get("Fit form");
       boundary_curvature       = prm.get_double("Boundary curvature");
+      curvature_radius         = prm.get_double("Curvature radius");
+      curvature_from_mesh      = prm.get_bool("Boundary curvature from mesh");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
       check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
-                        fit == "stabilized",
+                        fit == "stabilized" || fit == "sink",
                       "Absorbing boundary/Updating vector fit", fit,
-                      "least squares, monotone, bounded or stabilized");
+                      "least squares, monotone, bounded, stabilized or sink");
       check_parameter(l1_excess >= 0., "Absorbing boundary/Updating vector l1 excess", l1_excess, ">= 0");
     }
 
@@ -413,7 +439,8 @@ namespace PeriDEAL
       // what every caller, parsed or not, goes through).
       check_parameter(prm.imposed == "value" || prm.imposed == "normal derivative", "Absorbing boundary/Imposed",
                       prm.imposed, "value or normal derivative for the cloud fit (half derivative uses no clouds)");
-      check_parameter(prm.imposed == "value" || (flux && prm.fit != "bounded"), "Absorbing boundary/Imposed",
+      check_parameter(prm.imposed == "value" || (flux && prm.fit != "bounded" && prm.fit != "sink"),
+                      "Absorbing boundary/Imposed",
                       prm.imposed + " with the " + prm.fit + " fit",
                       "value, or normal derivative with the least squares, monotone or stabilized fit");
       const bool increment = prm.fit_form == "increment";
@@ -423,6 +450,13 @@ namespace PeriDEAL
                       "value, or increment with the least squares or stabilized fit and Imposed = value");
       check_parameter(prm.pseudo_inverse_tolerance >= 0. && prm.pseudo_inverse_tolerance < 1.,
                       "Absorbing boundary/Pseudo-inverse tolerance", prm.pseudo_inverse_tolerance, "in [0, 1)");
+      check_parameter(prm.curvature_radius == 0. || (dim > 1 && prm.curvature_radius > prm.cloud_radius),
+                      "Absorbing boundary/Curvature radius", prm.curvature_radius,
+                      "0 (plane modes), or in 2D/3D larger than the cloud radius");
+      const double rho = dim > 1 ? prm.curvature_radius : 0.;
+      // The curved modes' amplitude (rho/r)^{(dim-1)/2} has the normal
+      // derivative -(dim-1)/(2 rho) at x_i (r = rho there).
+      const double amplitude_slope = rho > 0. ? -(dim - 1.) / (2. * rho) : 0.;
       const unsigned int n_modes = dirs.size() * k.size() + (flux ? 1 : 0);
       Eigen::RowVectorXd psi_dt(n_modes);
       Tensor<1, dim>     e; // R n: the outward normal in the local frame
@@ -430,7 +464,7 @@ namespace PeriDEAL
         e[d] = 1. / std::sqrt(double(dim));
       for (unsigned int l = 0; l < dirs.size(); ++l)
         for (unsigned int m = 0; m < k.size(); ++m)
-          psi_dt[l * k.size() + m] = flux ? k[m] * (dirs[l] * e) : growth[m];
+          psi_dt[l * k.size() + m] = flux ? k[m] * (dirs[l] * e) + amplitude_slope : growth[m];
       if (flux)
         psi_dt[n_modes - 1] = 0.;
 
@@ -482,15 +516,32 @@ namespace PeriDEAL
 
           // Moment matrix (4.28) in the rotated frame (4.24).
           const Tensor<2, dim> R = local_frame(normals[a]);
+          const Tensor<1, dim> n = normals[a] / normals[a].norm();
           Eigen::MatrixXd      M(cloud.size(), n_modes);
           for (unsigned int j = 0; j < cloud.size(); ++j)
             {
-              const Tensor<1, dim> xbar = R * (points[cloud[j]] - xi);
+              Tensor<1, dim> y         = points[cloud[j]] - xi;
+              double         amplitude = 1.;
+              if (rho > 0.)
+                {
+                  // Curved coordinates about x_i - rho n: the distance
+                  // r - rho along n, the arc rho theta along the
+                  // tangential direction of y.
+                  const Tensor<1, dim> from_centre = y + rho * n;
+                  const double         radius      = from_centre.norm();
+                  const Tensor<1, dim> tangential  = from_centre - (from_centre * n) * n;
+                  const double         theta       = std::atan2(tangential.norm(), from_centre * n);
+                  y                                = (radius - rho) * n;
+                  if (tangential.norm() > 1e-14 * rho)
+                    y += (rho * theta / tangential.norm()) * tangential;
+                  amplitude = std::pow(rho / radius, 0.5 * (dim - 1.));
+                }
+              const Tensor<1, dim> xbar = R * y;
               for (unsigned int l = 0; l < dirs.size(); ++l)
                 {
                   const double s = dirs[l] * xbar;
                   for (unsigned int m = 0; m < k.size(); ++m)
-                    M(j, l * k.size() + m) = std::exp(k[m] * s);
+                    M(j, l * k.size() + m) = amplitude * std::exp(k[m] * s);
                 }
               if (flux)
                 M(j, n_modes - 1) = 1.;
@@ -534,6 +585,8 @@ namespace PeriDEAL
             V = fit_ls(psi_dt);
           else if (monotone)
             V = bounded_fit(M, psi_dt, 0., -1.);
+          else if (prm.fit == "sink")
+            V = sink_fit(M, psi_dt);
           else
             V = bounded_fit(M, psi_dt, prm.l1_excess, prm.lower_bound);
           if (prm.fit == "stabilized")
@@ -564,8 +617,10 @@ namespace PeriDEAL
           // (The stabilized fit applies the l1 bound as a cap on its blend.)
           // (The normal derivative's weights scale as 1/h: no norm guards;
           // the near field's stability check decides.)
-          const bool l1_ok = monotone || prm.fit == "stabilized" || flux || vl1 <= prm.max_update_l1;
-          if (!(cond <= prm.max_condition_number) || !(flux || vmax <= prm.max_update_norm) || !l1_ok)
+          const bool l1_ok = monotone || prm.fit == "stabilized" || prm.fit == "sink" || flux || vl1 <= prm.max_update_l1;
+          // (The sink fit is nonnegative least squares on M itself, no
+          // pseudo-inverse: its weights do not depend on the conditioning.)
+          if (!(prm.fit == "sink" || cond <= prm.max_condition_number) || !(flux || vmax <= prm.max_update_norm) || !l1_ok)
             {
               std::ostringstream v;
               v << "condition number " << cond << ", max |V_j| " << vmax << ", sum |V_j| " << vl1

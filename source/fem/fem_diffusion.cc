@@ -87,8 +87,13 @@ namespace PeriDEAL
         {
           check_parameter(abc_parameters.boundary_curvature >= 0., "Absorbing boundary/Boundary curvature",
                           abc_parameters.boundary_curvature, ">= 0");
-          half_dofs      = absorbing_dofs;
-          half_curvature = abc_parameters.boundary_curvature;
+          half_dofs = absorbing_dofs;
+          // Or the mesh's estimate per DoF (NearFieldLayout::curvatures),
+          // clipped at 0 (the flux stays a sink on concave parts).
+          half_curvature.assign(half_dofs.size(), abc_parameters.boundary_curvature);
+          if (abc_parameters.curvature_from_mesh)
+            for (unsigned int a = 0; a < half_dofs.size(); ++a)
+              half_curvature[a] = std::max(0., near_field.curvatures[a]);
           // Stability: the half derivative at t^{n+1} (Gruenwald-Letnikov,
           // weights g_0 = 1, g_j < 0 for j >= 1) and the curvature term are
           // taken at the boundary DoF's new value (local, no solve):
@@ -294,7 +299,7 @@ namespace PeriDEAL
               const unsigned int l = absorbing[a];
               const double       w = flux_weight.local_element(l);
               C.local_element(l)   = (C.local_element(l) - w * root_dt * boundary_values[a]) /
-                                   (1. + w * root_dt + 0.5 * dt * w * half_curvature);
+                                   (1. + w * root_dt + 0.5 * dt * w * half_curvature[a]);
             }
         }
       else if (flux_boundary)

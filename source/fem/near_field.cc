@@ -74,6 +74,7 @@ namespace PeriDEAL
       // Boundary DoFs (owned) and the sum of the adjacent boundary-face
       // normals: every cell touching an owned DoF is owned or ghost.
       std::map<types::global_dof_index, Tensor<1, dim>> normal_sum;
+      std::map<types::global_dof_index, std::pair<double, double>> curvature_sum;
       {
         const QGauss<dim - 1>                qf(1);
         FEFaceValues<dim>                    ff(mapping, dh.get_fe(), qf, update_normal_vectors);
@@ -97,6 +98,30 @@ namespace PeriDEAL
                         normal_sum[i] += ff.normal_vector(0);
                   }
             }
+        // Curvature: the normal curvature along the chord from each owned
+        // boundary DoF to the centres of its adjacent boundary faces.
+        for (const auto &cell : dh.active_cell_iterators())
+          if (!cell->is_artificial())
+            for (const unsigned int f : cell->face_indices())
+              if (cell->face(f)->at_boundary())
+                {
+                  ff.reinit(cell, f);
+                  cell->face(f)->get_dof_indices(fdofs);
+                  const Point<dim> centre = cell->face(f)->center();
+                  for (const auto i : fdofs)
+                    if (owned.is_element(i))
+                      {
+                        const Tensor<1, dim> chord = centre - support.at(i);
+                        // (A Q2 face-centre DoF has no chord.)
+                        const double h = cell->minimum_vertex_distance();
+                        if (chord.norm_square() <= 1e-12 * h * h)
+                          continue;
+                        const Tensor<1, dim> n = normal_sum.at(i) / normal_sum.at(i).norm();
+                        auto                &c = curvature_sum[i];
+                        c.first += (ff.normal_vector(0) - n) * chord / chord.norm_square();
+                        c.second += 1.;
+                      }
+                }
         min_cell_size = Utilities::MPI::min(hmin, comm);
         max_cell_size = Utilities::MPI::max(hmax, comm);
       }
@@ -147,10 +172,15 @@ namespace PeriDEAL
         }
       boundary.clear();
       normals.clear();
+      curvatures.clear();
       for (const auto &[i, n] : normal_sum)
         {
           boundary.push_back(partitioner->global_to_local(i));
           normals.push_back(n / n.norm());
+          const auto c = curvature_sum.find(i);
+          curvatures.push_back(c != curvature_sum.end() && c->second.second > 0. ?
+                                 (dim - 1.) * c->second.first / c->second.second :
+                                 0.);
         }
     }
 

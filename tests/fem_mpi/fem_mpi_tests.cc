@@ -106,13 +106,16 @@ namespace
   void
   diffusion_case(const std::string &name, const MeshMaker &mesh, const Fem::FemDiffusionParameters &fp,
                  const double cloud_radius, const unsigned int n_steps, const std::string &imposed = "value",
-                 const std::string &fit = "least squares", const double curvature = 0.)
+                 const std::string &fit = "least squares", const double curvature = 0.,
+                 const double curvature_radius = 0., const bool curvature_from_mesh = false)
   {
     Abc::EbfParameters ap;
     ap.cloud_radius       = cloud_radius;
     ap.imposed            = imposed;
     ap.fit                = fit;
     ap.boundary_curvature = curvature;
+    ap.curvature_radius   = curvature_radius;
+    ap.curvature_from_mesh = curvature_from_mesh;
     HeatKernel                                c0;
     parallel::distributed::Triangulation<2> ptria(MPI_COMM_WORLD);
     Triangulation<2>                          stria;
@@ -244,6 +247,14 @@ namespace
     // Session 12: the half-derivative flux (per boundary DoF, no clouds).
     diffusion_case("disk Q1 lumped forward Euler, half derivative", disk(2., 4), fp, 0.3, 200, "half derivative",
                    "least squares", 0.5);
+    // Session 13: the sub-stochastic (sink) value fit of curved modes
+    // about x_i - R n (NNLS per cloud; the clouds straddle the ranks).
+    diffusion_case("disk Q1 lumped forward Euler, sink fit, curved modes", disk(2., 4), fp, 0.3, 200, "value", "sink",
+                   0., 2.);
+    // The half derivative with the curvature estimated from the mesh (the
+    // adjacent faces of an owned DoF are owned or ghost cells).
+    diffusion_case("disk Q1 lumped forward Euler, half derivative, curvature from the mesh", disk(2., 4), fp, 0.3,
+                   200, "half derivative", "least squares", 0., 0., true);
   }
 
   Abc::WaveAbcParameters
@@ -381,6 +392,39 @@ namespace
             std::to_string(h[2] / h[1]) + "x)");
     check(h[0] < 1.7e-3 && h[3] < 1.7e-4, "disk, half derivative: max |Pi - Pi_exact|/Pi0 = " + sci(h[0]) +
                                              " < 1.7e-3, max |C - heat kernel| = " + sci(h[3]) + " < 1.7e-4");
+    // Session 13: the same with the curvature estimated per boundary DoF
+    // from the mesh (measured: end 1.402e-4, 284x, as with the given 1/R
+    // to 4 digits).
+    Abc::EbfParameters half_mesh   = half;
+    half_mesh.boundary_curvature  = 0.;
+    half_mesh.curvature_from_mesh = true;
+    const auto hm                 = run_disk_diffusion(half_mesh);
+    check(hm[2] >= 10. * hm[1] && hm[1] < 2.1e-4 && hm[0] < 1.7e-3,
+          "disk, half derivative with the mesh's curvature: end " + sci(hm[1]) + " < 2.1e-4 (" +
+            std::to_string(hm[2] / hm[1]) + "x), max " + sci(hm[0]) + " < 1.7e-3");
+    // Session 13: the sink fit (V_j >= 0, sum_j V_j <= 1) of the value
+    // form. Its sink follows the mode range, as the normal derivative's q
+    // did: end ratio vs Neumann with the curved modes (rho = R, 2D WKB
+    // amplitude sqrt(R/r)) at Delta k 3 / 5 / 7 / 10 (the default 2/d_inf):
+    // 31x / 20x / 9.9x / 7.1x; plane modes at Delta k 5 / 10: 56x / 7.8x.
+    // The pulse is wide at the boundary here (decay rate 8 r/s = 0.49 at
+    // t_end), so the default range over-absorbs. On the disk the curved
+    // modes lose against the plane ones (the 2D radial mode is K_0, not the
+    // WKB form); on the ball they gain (design.md, session 13). Asserted at
+    // Delta k 5: the curved and the plane sink fit; tolerances ~50 % above
+    // the measured errors, the ratio is the 10x.
+    for (const double rho : {3., 0.})
+      {
+        Abc::EbfParameters sink;
+        sink.fit               = "sink";
+        sink.wave_number_range = 5.;
+        sink.curvature_radius  = rho;
+        const auto f           = run_disk_diffusion(sink);
+        const std::string name = rho > 0. ? "disk, sink fit, curved modes" : "disk, sink fit, plane modes";
+        check(f[2] >= 10. * f[1] && f[0] < (rho > 0. ? 3e-3 : 2.5e-3),
+              name + ": at least 10x closer than Neumann at t_end (" + std::to_string(f[2] / f[1]) +
+                "x), max |Pi - Pi_exact|/Pi0 = " + sci(f[0]));
+      }
   }
 
   /** Max energy and probe differences of the EBF and first-order runs on a disk near field. */
@@ -605,7 +649,7 @@ namespace
    * erf(sqrt(a) L) - L exp(-a L^2)/(2a)), a = 8/s, s = 1 + 16 t) and the max
    * pointwise error; the same mesh with Neumann truncation as the baseline.
    */
-  std::array<double, 9>
+  std::array<double, 11>
   diffusion_3d(const bool ball, const double L, const unsigned int refinements, const double t_end,
                const double dt, const double cloud_radius, const std::string &fit = "least squares",
                const std::string &imposed = "value",
@@ -662,6 +706,33 @@ namespace
         std::cout << "  stabilized: " << st.n_blended << " clouds blended in " << st.stabilization_rounds
                   << " rounds, " << n_one << " at theta = 1, mean theta " << sum / abc.absorbing_points().size()
                   << ", max sum |V_j| " << st.max_update_l1 << std::endl;
+      }
+    // Curvature estimated from the mesh (Imposed = half derivative): the
+    // range over all boundary DoFs.
+    double kappa_min = 0., kappa_max = 0.;
+    if (ap.curvature_from_mesh)
+      {
+        const auto &k = ebf.layout().curvatures;
+        kappa_min     = Utilities::MPI::min(k.empty() ? 1e300 : *std::min_element(k.begin(), k.end()), MPI_COMM_WORLD);
+        kappa_max     = Utilities::MPI::max(k.empty() ? -1e300 : *std::max_element(k.begin(), k.end()), MPI_COMM_WORLD);
+        if (root())
+          std::cout << "  curvature from the mesh: " << kappa_min << " .. " << kappa_max << std::endl;
+      }
+    if (fit == "sink" && root())
+      {
+        // The sub-stochastic weights: sum_j V_j <= 1 (the sink 1 - sum).
+        const auto &abc = ebf.absorbing_boundary();
+        double      smin = 1., smax = 0., smean = 0.;
+        for (unsigned int a = 0; a < abc.absorbing_points().size(); ++a)
+          {
+            double sum = 0.;
+            for (const auto &jv : abc.cloud(a))
+              sum += jv.second;
+            smin = std::min(smin, sum);
+            smax = std::max(smax, sum);
+            smean += sum / abc.absorbing_points().size();
+          }
+        std::cout << "  sink: sum_j V_j " << smin << " .. " << smax << ", mean " << smean << std::endl;
       }
     if (imposed == "normal derivative" && root())
       {
@@ -737,7 +808,7 @@ namespace
       std::cout << "  " << (ball ? "ball" : "cube") << ": one-step growth power iteration (400 steps) "
                 << power_growth << ", Arnoldi (setup) " << ebf.stability_growth << std::endl;
     return {{max_ebf, end_ebf, end_neumann, err, double(n_below), min_excess, max_rise, power_growth,
-             ebf.stability_growth}};
+             ebf.stability_growth, kappa_min, kappa_max}};
   }
 
   /**
@@ -861,6 +932,47 @@ namespace
     check(ball_half[0] < 4e-3 && ball_half[6] <= 0.,
           "ball, half derivative: max |Pi - Pi_exact|/Pi0 = " + sci(ball_half[0]) +
             " < 4e-3, Pi non-increasing every step (largest change " + sci(ball_half[6]) + " Pi0)");
+    // Session 13: a cloud fit of the value form that reaches the 10x. The
+    // sink fit (V_j >= 0, sum_j V_j <= 1: nonnegative least squares
+    // without the constant's equality) keeps the max principle of the
+    // monotone fit but lets C_i fall below its cloud; with the curved modes
+    // about x_i - R n (exact (R/r) exp(k (r - R) + D k^2 t) along n) the
+    // fit returns sum_j V_j = 0.9975 .. 0.9982 (mean 0.9977: a sink of
+    // ~2.3e-3 per step, 2.3 per unit time). Measured: end 4.43e-3 vs Neumann 0.117 (26x;
+    // plane modes 8.2e-3, 14x; monotone 2.1e-2), max over the run = end,
+    // max |C - heat kernel| 2.9e-3, Pi lower after every step, growth
+    // 0.99688 (power iteration) / 0.99877 (Arnoldi); curvature radius 1.2 /
+    // 2 / 3: 32x / 22x / 19x; d_inf 0.6 96x, Delta k 8 23x, dt 5e-4 26x;
+    // refinement 4 (d_inf 0.3) 25x. Tolerance ~50 % above the measured
+    // error; the ratio is the 10x.
+    const auto ball_sink = diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "sink", "value",
+                                        [](Abc::EbfParameters &ap) { ap.curvature_radius = 1.5; });
+    check(ball_sink[2] >= 10. * ball_sink[1] && ball_sink[0] < 6.6e-3,
+          "ball, sink fit with curved modes: at least 10x closer than Neumann at t_end (" +
+            std::to_string(ball_sink[2] / ball_sink[1]) + "x), max |Pi - Pi_exact|/Pi0 = " + sci(ball_sink[0]) +
+            " < 6.6e-3");
+    check(ball_sink[6] <= 0. && ball_sink[7] <= 1. && ball_sink[8] <= 1.,
+          "ball, sink fit with curved modes: Pi non-increasing every step (largest change " + sci(ball_sink[6]) +
+            " Pi0), one-step growth <= 1 (power iteration " + std::to_string(ball_sink[7]) + ", Arnoldi " +
+            std::to_string(ball_sink[8]) + ")");
+    // Session 13: kappa estimated per boundary DoF from the mesh
+    // (NearFieldLayout::curvatures: (dim - 1) times the mean normal
+    // curvature along the chords to the adjacent boundary-face centres).
+    // Measured on the ball: 1.321 .. 1.442 (2/R = 1.333; refinement 4:
+    // 1.329 .. 1.394), end 3.59e-4 (325x; the given 2/R: 3.54e-4), max
+    // over the run 2.6e-3; cube 0 on the faces, up to 12.3 at the edges
+    // (rounded on the scale h): 1.8e-3 (24x; kappa 0: 2.1e-3).
+    // Asserted: every estimate within 10 % of 2/R, and the given-kappa
+    // tolerances.
+    const auto ball_mesh = diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "least squares", "half derivative",
+                                        [](Abc::EbfParameters &ap) { ap.curvature_from_mesh = true; });
+    check(std::abs(ball_mesh[9] - 2. / 1.5) <= 0.1 * 2. / 1.5 && std::abs(ball_mesh[10] - 2. / 1.5) <= 0.1 * 2. / 1.5,
+          "ball, curvature from the mesh within 10 % of 2/R: " + std::to_string(ball_mesh[9]) + " .. " +
+            std::to_string(ball_mesh[10]));
+    check(ball_mesh[2] >= 10. * ball_mesh[1] && ball_mesh[1] < 5.3e-4 && ball_mesh[0] < 4e-3 && ball_mesh[6] <= 0.,
+          "ball, half derivative with the mesh's curvature: end " + sci(ball_mesh[1]) +
+            " < 5.3e-4, at least 10x closer than Neumann (" + std::to_string(ball_mesh[2] / ball_mesh[1]) +
+            "x), max " + sci(ball_mesh[0]) + " < 4e-3, Pi non-increasing");
     const auto cube_half =
       diffusion_3d(false, 1.5, 4, 0.5, 1e-3, 0.45, "least squares", "half derivative", half_derivative(0.));
     check(cube_half[2] >= 10. * cube_half[1] && cube_half[0] < 8e-3 && cube_half[6] <= 0.,
@@ -872,8 +984,8 @@ namespace
   /**
    * Exploratory scan (not a ctest case): FEMBALL_SCAN="key=value;..." with
    * shape (ball|cube|disk), fit, form, rcond, dinf, dk, nk, nphi, dt,
-   * imposed, ref, t, checksteps; prints the energy errors and the one-step
-   * spectral radius.
+   * imposed, ref, t, checksteps, kappa, distributed, rho; prints the energy
+   * errors and the one-step spectral radius.
    */
   void
   femball_scan()
@@ -882,7 +994,8 @@ namespace
     std::map<std::string, std::string> kv{{"shape", "ball"}, {"fit", "least squares"}, {"form", "value"},
                                           {"rcond", "0"}, {"dinf", "0.45"}, {"dk", "0"}, {"nk", "20"},
                                           {"nphi", "5"}, {"dt", "1e-3"}, {"imposed", "value"}, {"ref", "3"},
-                                          {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"}};
+                                          {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"},
+                                          {"rho", "0"}};
     std::string spec = env ? env : "";
     for (std::size_t pos = 0; pos < spec.size();)
       {
@@ -900,7 +1013,9 @@ namespace
       ap.n_wave_numbers           = std::stoi(kv["nk"]);
       ap.n_directions             = std::stoi(kv["nphi"]);
       ap.stability_check_steps    = std::stoi(kv["checksteps"]);
-      ap.boundary_curvature       = std::stod(kv["kappa"]);
+      ap.boundary_curvature       = kv["kappa"] == "mesh" ? 0. : std::stod(kv["kappa"]);
+      ap.curvature_radius         = std::stod(kv["rho"]);
+      ap.curvature_from_mesh      = kv["kappa"] == "mesh";
       if (kv["fit"] != "monotone")
         ap.max_update_norm = 1e10;
     };

@@ -53,7 +53,13 @@ namespace PeriDEAL
        * sum_j V_j = 1 (the constant far field is kept exactly). With a
        * monotone near field (forward Euler at dt <= 1 / max row sum) every
        * row of the one-step map is then a convex combination, so
-       * max_i |C_i| cannot grow: stable for every cloud shape.
+       * max_i |C_i| cannot grow: stable for every cloud shape. "sink"
+       * (Imposed = value): nonnegative least squares without the equality,
+       * V_j >= 0 and sum_j V_j <= 1 (scaled down if the fit exceeds 1): the
+       * same max principle, but the value can fall below every value of its
+       * cloud, which a convex combination cannot (a curved boundary whose
+       * values rise inward while they fall in time). A constant far field
+       * is not preserved (sum_j V_j < 1 drains it).
        */
       std::string fit = "least squares";
       /**
@@ -89,6 +95,12 @@ namespace PeriDEAL
        * constant set by Delta k; here the rate follows the field's history.
        */
       double boundary_curvature = 0.;
+      /**
+       * Imposed = "half derivative" (FEM): instead of boundary_curvature,
+       * the curvature per boundary DoF estimated from the mesh
+       * (Fem::NearFieldLayout::curvatures, clipped at 0).
+       */
+      bool curvature_from_mesh = false;
       /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
       double lower_bound = -1.;
       /**
@@ -130,6 +142,18 @@ namespace PeriDEAL
        * its whole cloud, which no convex combination can.
        */
       std::string fit_form = "value";
+      /**
+       * Curved modes (2D/3D, cloud fits): the radius rho of the outgoing
+       * fronts at the boundary (0: plane modes exp(k d.x), the source). With
+       * rho > 0 every mode is evaluated in the coordinates about the centre
+       * x_i - rho n, s = (r - rho) n + rho theta t (r the distance to the
+       * centre, theta the angle from n, t the tangential direction), times
+       * the amplitude (rho/r)^{(dim-1)/2}: the normal modes are then the
+       * exact outgoing spherical solutions (rho/r) exp(k (r - rho) + D k^2 t)
+       * in 3D and their WKB form sqrt(rho/r) exp(k (r - rho)) in 2D
+       * (e.g. rho = R on a ball near field centred at the source).
+       */
+      double curvature_radius = 0.;
 
       static void
       declare_parameters(ParameterHandler &prm);

@@ -215,7 +215,8 @@ namespace PeriDEAL
        */
       bool                           half_derivative = false;
       std::vector<unsigned int>      half_dofs;
-      double                         half_curvature = 0.;
+      /** Imposed = half derivative: kappa per boundary DoF (given or estimated). */
+      std::vector<double>            half_curvature;
       std::vector<double>            half_history, gl_weights;
       unsigned int                   n_history_levels = 0;
       SolverControl                  solver_control;

@@ -89,6 +89,14 @@ namespace PeriDEAL
       /** Local indices of the owned boundary DoFs and their outward unit normals. */
       std::vector<unsigned int>   boundary;
       std::vector<Tensor<1, dim>> normals;
+      /**
+       * Estimated sum of the principal curvatures at the owned boundary
+       * DoFs (2/R on a sphere, 1/R on a circle, 0 on flat faces): (dim - 1)
+       * times the mean over the adjacent boundary faces f of
+       * (n_f - n_i).(c_f - x_i) / |c_f - x_i|^2 (the normal curvature along
+       * the chord to the face centre c_f). Same order as @p boundary.
+       */
+      std::vector<double> curvatures;
       /** Smallest vertex distance of the mesh (global). */
       double min_cell_size = 0.;
       /** Largest cell diameter-like size: max over cells of the minimum vertex distance (global). */
