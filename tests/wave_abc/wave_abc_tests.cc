@@ -1826,7 +1826,7 @@ namespace
    * filter; radii=2.5,4 (spectral discs), dts=0.02 (their time steps),
    * run=1 (E14 reduced field and energy errors at t = 2R), long=n (n steps
    * from a rough state on the disc long_R, default R), diag=1 (where the
-   * dominant eigenvector of the first disc sits).
+   * dominant eigenvector of the first disc and time step sits).
    */
   void
   e14_scan()
@@ -1887,6 +1887,7 @@ namespace
         };
         std::istringstream radii(list("radii", "2.5"));
         double             Rd = 0.;
+        bool               first = true;
         while (radii >> Rd && Rd > 0.) // radii=0: no spectral disc
           {
             std::istringstream dts(list("dts", "0.02"));
@@ -1901,7 +1902,8 @@ namespace
                     unsigned int            n_up = 0;
                     WaveCloudStatistics     st;
                     WaveSpectralDiagnostics diag;
-                    const bool              want = num("diag", 0.) > 0. && Rd == 2.5 && dt == 0.02;
+                    const bool              want = num("diag", 0.) > 0. && first;
+                    first                        = false;
                     const double            r    = radius_2d(Rd, q, lp.dx, 6, &n_up, &st, nullptr, want ? &diag : nullptr,
                                                   WaveTruncation::absorbing, dt);
                     std::cout << "    R " << Rd << " dt " << dt << ": rho - 1 = " << sci(r - 1.) << " (" << n_up
