@@ -1634,6 +1634,32 @@ namespace
     check(inc <= 1e-14, "sponge: E^{n+1/2} non-increasing in every one of 1e6 steps (largest change " + sci(inc) + " E0)");
   }
 
+  /** Total energy at the start and after each of @p n_samples equal parts of @p n_steps steps. */
+  template <int dim>
+  std::vector<double>
+  sampled_energy(PdUnboundedWave<dim> &pd, const unsigned long n_steps, const unsigned int n_samples)
+  {
+    const auto          all = [](const Point<dim> &) { return true; };
+    std::vector<double> e{pd.energy(all)};
+    for (unsigned int s = 1; s <= n_samples; ++s)
+      {
+        for (unsigned long k = 0; k < n_steps / n_samples; ++k)
+          pd.advance();
+        e.push_back(pd.energy(all));
+      }
+    return e;
+  }
+
+  /** A rough pseudo-random initial state in [-1/2, 1/2) (every lattice mode excited). */
+  ScalarFunctionFromFunctionObject<2>
+  rough_state()
+  {
+    return ScalarFunctionFromFunctionObject<2>([](const Point<2> &p) {
+      const double h = std::sin(12.9898 * p[0] + 78.233 * p[1]) * 43758.5453;
+      return h - std::floor(h) - 0.5;
+    });
+  }
+
   /**
    * Total energy of the E14 pulse on the disc R = 2.5 + w with the PML of
    * pml_parameters(2, w, 2), sampled every n_steps/n_samples steps (the
@@ -1644,15 +1670,7 @@ namespace
   {
     PdUnboundedWave<2> pd(MPI_COMM_SELF);
     setup_e14_disc(pd, 2.5 + w, WaveTruncation::absorbing, pml_parameters(2., w, 2.));
-    const auto          all = [](const Point<2> &) { return true; };
-    std::vector<double> e{pd.energy(all)};
-    for (unsigned int s = 1; s <= n_samples; ++s)
-      {
-        for (unsigned long k = 0; k < n_steps / n_samples; ++k)
-          pd.advance();
-        e.push_back(pd.energy(all));
-      }
-    return e;
+    return sampled_energy(pd, n_steps, n_samples);
   }
 
   // The PML (session 8): long-run behaviour on a small disc and the input
@@ -1752,9 +1770,9 @@ namespace
 
   /**
    * Energy of the E14 near field (disc @p R, e14_stable_parameters(R)) from
-   * a rough pseudo-random state, sampled @p n_samples times over @p n_steps:
-   * every lattice mode is excited, so a growing one cannot hide below
-   * round-off as it can behind a smooth pulse.
+   * rough_state(), sampled @p n_samples times over @p n_steps: every
+   * lattice mode is excited, so a growing one cannot hide below round-off
+   * as it can behind a smooth pulse.
    */
   std::vector<double>
   stable_energy_history(const double R, const unsigned long n_steps, const unsigned int n_samples)
@@ -1762,21 +1780,9 @@ namespace
     LatticeParameters    lp;
     ScalarWaveParameters mp;
     e14_parameters(lp, mp);
-    const ScalarFunctionFromFunctionObject<2> rough([](const Point<2> &p) {
-      const double h = std::sin(12.9898 * p[0] + 78.233 * p[1]) * 43758.5453;
-      return h - std::floor(h) - 0.5;
-    });
     PdUnboundedWave<2> pd(MPI_COMM_WORLD);
-    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, WaveTruncation::absorbing, e14_stable_parameters(R), rough);
-    const auto          all = [](const Point<2> &) { return true; };
-    std::vector<double> e{pd.energy(all)};
-    for (unsigned int s = 1; s <= n_samples; ++s)
-      {
-        for (unsigned long k = 0; k < n_steps / n_samples; ++k)
-          pd.advance();
-        e.push_back(pd.energy(all));
-      }
-    return e;
+    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, WaveTruncation::absorbing, e14_stable_parameters(R), rough_state());
+    return sampled_energy(pd, n_steps, n_samples);
   }
 
   /** Largest ratio e[s] / e[s-1] - 1 of consecutive samples. */
@@ -1790,11 +1796,12 @@ namespace
   }
 
   // The long-run stable m = 6 EBF layer (session 13): one-step spectral
-  // radius <= 1 + 1e-8 on the disc R = 2.5 at dt = 0.02 and 0.005 (measured
-  // 1 - 2.0e-4 and ..., and at R = 3, 3.5, 4), and the energy of the R = 8
-  // disc from a rough state non-increasing between samples. Small discs
-  // alone are not enough: d_inf = 3 dx, rcond 1e-5 has radius < 1 on
-  // R = 2.5, 3, 3.5 at dt = 0.02 and grows on R = 8 (design.md).
+  // radius <= 1 + 1e-8 on the disc R = 2.5 at dt = 0.02 and 0.005
+  // (measured 1 - 2.04e-4 and 1 - 5.04e-5; also < 1 on R = 3, 3.5, 4), and
+  // the energy of the R = 8 disc from a rough state decreasing between
+  // samples. Small discs alone are not enough: d_inf = 3 dx, rcond 1e-5,
+  // cone 0.9 has radius < 1 on R = 2.5 .. 4 at dt = 0.02 and grows on
+  // R = 8 (design.md, session 13).
   void
   pd_2d_stable(const bool long_run)
   {
@@ -1956,10 +1963,6 @@ namespace
             // Power iteration by time stepping on the E14 disc (radius
             // long_R, default R) from a rough pseudo-random state: every
             // lattice mode is excited, so a growing one shows up.
-            const ScalarFunctionFromFunctionObject<2> rough([](const Point<2> &p) {
-              const double h = std::sin(12.9898 * p[0] + 78.233 * p[1]) * 43758.5453;
-              return h - std::floor(h) - 0.5;
-            });
             WaveAbcParameters q = prm;
             const double      Rl = num("long_R", R);
             q.curvature_radius  = rho > 0. ? Rl : 0.;
@@ -1967,18 +1970,12 @@ namespace
               {
                 Timer              timer;
                 PdUnboundedWave<2> pd(MPI_COMM_SELF);
-                pd.setup(BallDomain<2>(Point<2>(), Rl), lp, mp, WaveTruncation::absorbing, q, rough);
-                const auto          all = [](const Point<2> &) { return true; };
-                const unsigned long n   = static_cast<unsigned long>(num("long", 0.));
-                std::vector<double> e{pd.energy(all)};
+                pd.setup(BallDomain<2>(Point<2>(), Rl), lp, mp, WaveTruncation::absorbing, q, rough_state());
+                const unsigned long       n = static_cast<unsigned long>(num("long", 0.));
+                const std::vector<double> e = sampled_energy(pd, n, 10);
                 std::cout << "    long run R = " << Rl << ", " << n << " steps, E/E0:";
                 for (unsigned int s = 1; s <= 10; ++s)
-                  {
-                    for (unsigned long k = 0; k < n / 10; ++k)
-                      pd.advance();
-                    e.push_back(pd.energy(all));
-                    std::cout << " " << sci(e.back() / e[0]);
-                  }
+                  std::cout << " " << sci(e[s] / e[0]);
                 std::cout << " | per-step growth of sqrt(E) over the last tenth "
                           << sci(std::pow(e[10] / e[9], 0.5 / (n / 10)) - 1.) << " (" << sci(timer.cpu_time()) << " s)"
                           << std::endl;
