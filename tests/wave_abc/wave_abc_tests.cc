@@ -1845,8 +1845,7 @@ namespace
     LatticeParameters    lp;
     ScalarWaveParameters mp;
     e14_parameters(lp, mp);
-    const ScalarFunctionFromFunctionObject<2> u0(
-      [](const Point<2> &p) { return std::exp(-std::log(2.) * p.square()); });
+    const auto         u0        = e15_initial(); // the E14 pulse as well
     const auto         inner     = [&](const Point<2> &p) { return p.norm() < R - lp.delta - 1e-9; };
     const unsigned int n_samples = 8;
     std::unique_ptr<History<2>> ref;
