@@ -901,6 +901,10 @@ namespace PeriDEAL
           if (broken_flag[b] == 0)
             sweep_live[(L / 8) * n_f + sweep_of_box[box_index(i, b)]] |= std::uint8_t(1u << (L % 8));
       }
+    full_lanes.assign(nv, 0xFF);
+    for (std::size_t v = 0; v < nv; ++v)
+      for (std::size_t f = 0; f < n_f; ++f)
+        full_lanes[v] &= sweep_live[v * n_f + f];
     sweep_live_valid = true;
     half_mask_valid  = false;
   }
@@ -1256,23 +1260,7 @@ namespace PeriDEAL
             // Every bond of the tested lanes alive (the usual case: Omega_w
             // nodes have full families, and a bond with an Omega_w end breaks
             // only after the end switched): the grouped kernel, no masks.
-            std::uint64_t full = 0;
-            if (lip && grouped_on)
-              {
-                full = ~std::uint64_t(0);
-                std::size_t f = 0;
-                for (; f + 8 <= n_f; f += 8)
-                  {
-                    std::uint64_t w;
-                    std::memcpy(&w, bits + f, 8);
-                    full &= w;
-                  }
-                for (; f < n_f; ++f)
-                  full &= bits[f] | ~std::uint64_t(0xFF);
-                full &= full >> 32;
-                full &= full >> 16;
-                full &= full >> 8;
-              }
+            const unsigned full = full_lanes[v];
             const bool grouped = lip && grouped_on && (full & tl) == tl;
             __m512d    qmax;
             if (half)
@@ -1511,6 +1499,10 @@ namespace PeriDEAL
         const unsigned int  g = sweep_mirror[f];
         sweep_live[(L / 8) * n_f + f] &= std::uint8_t(~(1u << (L % 8)));
         sweep_live[(M / 8) * n_f + g] &= std::uint8_t(~(1u << (M % 8)));
+        if (L / 8 < full_lanes.size())
+          full_lanes[L / 8] &= std::uint8_t(~(1u << (L % 8)));
+        if (M / 8 < full_lanes.size())
+          full_lanes[M / 8] &= std::uint8_t(~(1u << (M % 8)));
         // The half-stencil sweep's entries are (positive offset, lower end).
         if (half_mask_valid && sweep_offset[f] > 0 && half_index[L / 8] >= 0)
           half_mask[std::size_t(half_index[L / 8]) * half_offsets.size() + half_slot[f]] &=

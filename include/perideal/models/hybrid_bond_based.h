@@ -524,6 +524,12 @@ namespace PeriDEAL
      */
     std::vector<std::uint8_t>  sweep_live;
     bool                       sweep_live_valid = false;
+    /**
+     * Per vector: the lanes whose bit is set at every offset (all bonds
+     * alive; the AND of the vector's bytes of sweep_live, kept with it), so
+     * that the exact test picks its kernel without reading the bits.
+     */
+    std::vector<std::uint8_t>  full_lanes;
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
     /** x - x_c over the box (layout of sweep_p). */
