@@ -6,7 +6,7 @@
 //
 //   kw_hybrid_benchmark [--dx 0.25] [--m 8] [--end-time 87.5e-6] [--sigma 0.95]
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
-//                       [--chunk 16] [--half-stencil 0|1]
+//                       [--chunk 16] [--half-stencil 0|1] [--grouped-test 0|1]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -20,7 +20,9 @@
 // (the same result, more exact node tests). --half-stencil 1 evaluates the
 // Omega_s rows as a half-stencil sweep with reactions instead of their full
 // stencils (HybridMechanicsParameters::half_stencil, default off; the same
-// bonds, another summation order).
+// bonds, another summation order). --grouped-test 0 keeps the per-offset
+// masked kernel of the exact switching test (length_grouped_test, default
+// on; the same q bit for bit).
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
 // at y = +-25). The source uses dx = 0.25 mm, delta = 2 mm (m = 8) and
@@ -76,7 +78,7 @@ main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
-  int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1;
+  int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1;
   std::string dir = "kw-hybrid-benchmark", bound = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
@@ -97,6 +99,8 @@ main(int argc, char **argv)
         bound = value;
       else if (key == "--half-stencil")
         half_stencil = std::stoi(value);
+      else if (key == "--grouped-test")
+        grouped_test = std::stoi(value);
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -120,6 +124,8 @@ main(int argc, char **argv)
   ph.hybrid.lattice_bound   = bound == "lattice";
   if (half_stencil >= 0)
     ph.hybrid.half_stencil = half_stencil != 0;
+  if (grouped_test >= 0)
+    ph.hybrid.length_grouped_test = grouped_test != 0;
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = cpu_seconds() - t0;

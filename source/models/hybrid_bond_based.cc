@@ -8,6 +8,7 @@
 #include <complex>
 #include <map>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -272,6 +273,63 @@ namespace PeriDEAL
       for (; g < n_g; ++g)
         step(q0, g);
       return S::max(S::max(q0, q1), S::max(q2, q3));
+    }
+
+    /**
+     * max_ratio() of W lanes whose bonds at every offset are alive, in the
+     * @p lanes kept (0 in the others): per group g of the offsets of one
+     * 1 / T^2 (iL2[g]; offset[start[g], start[g + 1]), none empty) the
+     * maximum of |y|^2, times iL2[g]. The same q bit for bit: x -> fl(x c)
+     * is monotone for c > 0, so fl(max x c) = max fl(x c), and a maximum is
+     * exact in any order. No lane masks and one multiplication per group
+     * instead of one per offset (KW dx = 0.25: 0.88 x the cycles of
+     * max_ratio(), the same q in 4.4 M of 4.4 M calls).
+     */
+    template <int dim, int W>
+    inline typename Lanes<W>::V
+    max_ratio_grouped(const double *p, const std::size_t N, const std::size_t L,
+                      const std::int64_t *offset, const std::uint32_t *start, const double *iL2,
+                      const unsigned int n_groups, const __mmask8 lanes)
+    {
+      using S = Lanes<W>;
+      typename S::V pi[dim];
+      for (unsigned int d = 0; d < dim; ++d)
+        pi[d] = S::load(p + d * N + L);
+      const auto l2_of = [&](const std::int64_t o) {
+        typename S::V y  = S::sub(S::load(p + L + o), pi[0]);
+        typename S::V l2 = S::mul(y, y);
+        for (unsigned int d = 1; d < dim; ++d)
+          {
+            y  = S::sub(S::load(p + d * N + L + o), pi[d]);
+            l2 = S::fmadd(y, y, l2);
+          }
+        return l2;
+      };
+      typename S::V q0 = S::set1(0.), q1 = q0;
+      for (unsigned int g = 0; g < n_groups; ++g)
+        {
+          // Two maxima per group (one chain is latency bound).
+          unsigned int       f = start[g];
+          const unsigned int e = start[g + 1];
+          typename S::V m0 = l2_of(offset[f]), m1 = m0;
+          for (++f; f + 2 <= e; f += 2)
+            {
+              m0 = S::max(m0, l2_of(offset[f]));
+              m1 = S::max(m1, l2_of(offset[f + 1]));
+            }
+          if (f < e)
+            m0 = S::max(m0, l2_of(offset[f]));
+          const typename S::V x = S::mul(S::max(m0, m1), S::set1(iL2[g]));
+          if (g % 2 == 0)
+            q0 = S::max(q0, x);
+          else
+            q1 = S::max(q1, x);
+        }
+      const typename S::V q = S::max(q0, q1);
+      if constexpr (S::wide)
+        return _mm512_maskz_mov_pd(lanes, q);
+      else
+        return _mm256_maskz_mov_pd(lanes, q);
     }
 #endif
   } // namespace
@@ -652,6 +710,7 @@ namespace PeriDEAL
     for (unsigned int f = 0; f < all_offsets.size(); ++f)
       all_offsets[f] = f;
     lattice_bound_on = false;
+    grouped_on       = false;
     if constexpr (dim == 2)
       if (prm.switching_bound && prm.lattice_bound && std::isfinite(s0))
         {
@@ -711,6 +770,25 @@ namespace PeriDEAL
           lip_have_prev    = false;
           lip_swap_pending = false;
           lattice_bound_on = true;
+          // Offsets of bitwise equal 1 / T^2 (a bond length and its lattice
+          // symmetries) as one group each, in box order within a group.
+          grouped_on = prm.length_grouped_test;
+          std::vector<unsigned int> by_length(all_offsets);
+          std::stable_sort(by_length.begin(), by_length.end(),
+                           [&](const unsigned int a, const unsigned int b) { return sweep_iL2[a] < sweep_iL2[b]; });
+          grouped_offset.clear();
+          group_start.clear();
+          group_iL2.clear();
+          for (const unsigned int f : by_length)
+            {
+              if (group_iL2.empty() || sweep_iL2[f] != group_iL2.back())
+                {
+                  group_start.push_back(grouped_offset.size());
+                  group_iL2.push_back(sweep_iL2[f]);
+                }
+              grouped_offset.push_back(sweep_offset[f]);
+            }
+          group_start.push_back(grouped_offset.size());
         }
 #endif
   }
@@ -823,6 +901,10 @@ namespace PeriDEAL
           if (broken_flag[b] == 0)
             sweep_live[(L / 8) * n_f + sweep_of_box[box_index(i, b)]] |= std::uint8_t(1u << (L % 8));
       }
+    full_lanes.assign(nv, 0xFF);
+    for (std::size_t v = 0; v < nv; ++v)
+      for (std::size_t f = 0; f < n_f; ++f)
+        full_lanes[v] &= sweep_live[v * n_f + f];
     sweep_live_valid = true;
     half_mask_valid  = false;
   }
@@ -1175,13 +1257,25 @@ namespace PeriDEAL
             // q >= 1 - 1e-12 are scanned again for the bonds with
             // |y|^2 >= T^2 (l2 >= L2 implies l2 fl(1/L2) >= 1 - 3e-16).
             // The lattice bound's group is every offset in order.
-            __m512d qmax;
+            // Every bond of the tested lanes alive (the usual case: Omega_w
+            // nodes have full families, and a bond with an Omega_w end breaks
+            // only after the end switched): the grouped kernel, no masks.
+            const unsigned full = full_lanes[v];
+            const bool grouped = lip && grouped_on && (full & tl) == tl;
+            __m512d    qmax;
             if (half)
               {
-                const __m256d q4 = max_ratio<dim, 4, true>(p, N, L0 + 4 * h, offset, iL2, bits, 4 * h,
-                                                           __mmask8(tl >> (4 * h)), nullptr, group.size());
+                const __mmask8 m4 = __mmask8(tl >> (4 * h));
+                const __m256d  q4 =
+                  grouped ? max_ratio_grouped<dim, 4>(p, N, L0 + 4 * h, grouped_offset.data(), group_start.data(),
+                                                      group_iL2.data(), group_iL2.size(), m4) :
+                            max_ratio<dim, 4, true>(p, N, L0 + 4 * h, offset, iL2, bits, 4 * h, m4, nullptr,
+                                                    group.size());
                 qmax = h ? _mm512_insertf64x4(_mm512_setzero_pd(), q4, 1) : _mm512_zextpd256_pd512(q4);
               }
+            else if (grouped)
+              qmax = max_ratio_grouped<dim, 8>(p, N, L0, grouped_offset.data(), group_start.data(),
+                                               group_iL2.data(), group_iL2.size(), tl);
             else if (lip)
               qmax = max_ratio<dim, 8, true>(p, N, L0, offset, iL2, bits, 0, lanes, nullptr, group.size());
             else
@@ -1405,6 +1499,10 @@ namespace PeriDEAL
         const unsigned int  g = sweep_mirror[f];
         sweep_live[(L / 8) * n_f + f] &= std::uint8_t(~(1u << (L % 8)));
         sweep_live[(M / 8) * n_f + g] &= std::uint8_t(~(1u << (M % 8)));
+        if (L / 8 < full_lanes.size())
+          full_lanes[L / 8] &= std::uint8_t(~(1u << (L % 8)));
+        if (M / 8 < full_lanes.size())
+          full_lanes[M / 8] &= std::uint8_t(~(1u << (M % 8)));
         // The half-stencil sweep's entries are (positive offset, lower end).
         if (half_mask_valid && sweep_offset[f] > 0 && half_index[L / 8] >= 0)
           half_mask[std::size_t(half_index[L / 8]) * half_offsets.size() + half_slot[f]] &=

@@ -15,6 +15,10 @@
 //             (StretchBudget);
 //  kw_lattice: amortized = every-step test with the lattice bound (and
 //             fewer exact node tests than with StretchBudget);
+//  kw_equivalence: the fast switching test = the exact test of every bond
+//             at every step (KW at CI size, 1 or 2 ranks);
+//  grouped_test: the exact test's kernel grouped by bond length = the
+//             per-offset masked kernel (the same exact node tests too);
 //  half_stencil: the half-stencil Omega_s sweep = the full-stencil rows
 //             (broken bonds, switching, damage; forces to round-off);
 //  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
@@ -32,6 +36,7 @@
 #include "kalthoff_winkler_case.h"
 #include "stretch_budget_test.h"
 
+#include <functional>
 #include <map>
 
 using namespace dealii;
@@ -700,19 +705,26 @@ namespace
               " (StretchBudget)");
   }
 
-  // (h) The fast switching test (lattice bound, p formed only where read)
-  // against the exact test of every bond at every step, on KW at CI size
-  // (dx = 1 mm, delta = 4 mm, 20,000 nodes) on MPI_COMM_WORLD (1 or 2
-  // ranks): per node the same switch evaluation (hence the same switched
-  // set), bitwise the same damage and displacement.
-  void
-  kw_equivalence()
+  /**
+   * KW at CI size (dx = 1 mm, delta = 4 mm, 20,000 nodes, sigma = 0.8) on
+   * MPI_COMM_WORLD with two variants of the hybrid's parameters (@p a is
+   * the path under test, @p b the reference): checks per node the same
+   * switch evaluation (hence the same switched set), the same switch
+   * events, broken and overstretched bonds, bitwise the same damage and
+   * displacement. Output below @p dir. Returns the exact node tests of (a,
+   * b).
+   */
+  std::pair<std::uint64_t, std::uint64_t>
+  check_kw_same(const std::function<void(HybridMechanicsParameters &)> &a,
+                const std::function<void(HybridMechanicsParameters &)> &b,
+                const std::string &reference, const std::string &dir)
   {
     const double dx = 1., delta = 4., T = 87.5e-6;
-    auto         pf = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, "kw-equivalence");
+    auto         pf = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, dir);
     auto         pe = pf;
-    pe.hybrid.switching_bound = false;
-    pe.output_directory       = "kw-equivalence-every-step";
+    pe.output_directory = dir + "-reference";
+    a(pf.hybrid);
+    b(pe.hybrid);
     MechanicsSolver<2> fast(MPI_COMM_WORLD, pf), every(MPI_COMM_WORLD, pe);
     fast.run();
     every.run();
@@ -738,7 +750,7 @@ namespace
     const auto   sf = states(fast), se = states(every);
     unsigned int n_switched = 0, switch_differ = 0, missing = 0;
     double       damage_diff = 0., u_diff = 0., u_max = 0.;
-    for (const auto &[id, a] : sf)
+    for (const auto &[id, st] : sf)
       {
         const auto it = se.find(id);
         if (it == se.end())
@@ -746,14 +758,14 @@ namespace
             ++missing;
             continue;
           }
-        const State &b = it->second;
-        n_switched += a.switched >= 0;
-        switch_differ += a.switched != b.switched;
-        damage_diff = std::max(damage_diff, std::abs(a.damage - b.damage));
+        const State &o = it->second;
+        n_switched += st.switched >= 0;
+        switch_differ += st.switched != o.switched;
+        damage_diff = std::max(damage_diff, std::abs(st.damage - o.damage));
         for (unsigned int d = 0; d < 2; ++d)
           {
-            u_diff = std::max(u_diff, std::abs(a.u[d] - b.u[d]));
-            u_max  = std::max(u_max, std::abs(b.u[d]));
+            u_diff = std::max(u_diff, std::abs(st.u[d] - o.u[d]));
+            u_max  = std::max(u_max, std::abs(o.u[d]));
           }
       }
     const MPI_Comm comm = MPI_COMM_WORLD;
@@ -771,7 +783,7 @@ namespace
             hf->n_switch_events() == he->n_switch_events() &&
             hf->n_standard_nodes() == he->n_standard_nodes(),
           std::to_string(n_switched) + " switched nodes, each at the same force evaluation as "
-            "with the exact test of every bond (" + std::to_string(switch_differ) + " differ; " +
+            "with " + reference + " (" + std::to_string(switch_differ) + " differ; " +
             std::to_string(hf->n_switch_events()) + " / " + std::to_string(he->n_switch_events()) +
             " switch events)");
     check(hf->n_overstretched_bonds() == he->n_overstretched_bonds() &&
@@ -782,14 +794,47 @@ namespace
     check(damage_diff == 0. && u_diff == 0. && u_max > 0.,
           "max |damage difference| = " + sci(damage_diff) + ", max |u difference| = " +
             sci(u_diff) + " (max |u| = " + sci(u_max) + ")");
+    if (root())
+      std::cout << "  lattice sweep: " << (hf->uses_lattice_sweep() ? "yes" : "no")
+                << ", exact node tests " << tests_fast << " / " << tests_every << " (" << reference
+                << ")" << std::endl;
+    return {tests_fast, tests_every};
+  }
+
+  // (h) The fast switching test (lattice bound, p formed only where read)
+  // against the exact test of every bond at every step, on KW at CI size
+  // on 1 or 2 ranks (check_kw_same()).
+  void
+  kw_equivalence()
+  {
+    const auto [tests_fast, tests_every] = check_kw_same(
+      [](HybridMechanicsParameters &) {},
+      [](HybridMechanicsParameters &h) { h.switching_bound = false; },
+      "the exact test of every bond at every step", "kw-equivalence");
     // The fast path is the one under test: the lattice sweep with its
     // bound (AVX-512; else the portable rows with StretchBudget) skips most
     // exact node tests.
-    if (root())
-      std::cout << "  lattice sweep: " << (hf->uses_lattice_sweep() ? "yes" : "no")
-                << ", exact node tests " << tests_fast << " (fast) / " << tests_every
-                << " (every step)" << std::endl;
     check(tests_fast < 0.25 * tests_every, "most exact node tests skipped");
+  }
+
+  // (h2) The exact test's kernel grouped by bond length (no lane masks,
+  // length_grouped_test, the default) against the per-offset masked
+  // kernel, on KW at CI size on 1 or 2 ranks: both compute q = max |y|^2 /
+  // T^2 bit for bit, so the slack of every node, hence the exact node tests
+  // (not only the outcome), must be the same, as must the switches, damage
+  // and displacements. A q that is too small would skip needed tests (the
+  // switch evaluations differ, see kw_equivalence), a q that is too large
+  // adds exact tests.
+  void
+  grouped_test()
+  {
+    const auto [tests_grouped, tests_masked] = check_kw_same(
+      [](HybridMechanicsParameters &h) { h.length_grouped_test = true; },
+      [](HybridMechanicsParameters &h) { h.length_grouped_test = false; },
+      "the per-offset masked kernel", "kw-grouped-test");
+    check(tests_grouped == tests_masked && tests_grouped > 0,
+          "the same exact node tests: " + std::to_string(tests_grouped) + " / " +
+            std::to_string(tests_masked));
   }
 
   // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
@@ -834,6 +879,7 @@ main(int argc, char **argv)
               {"kw_classes", kw_classes},
               {"kw_lattice", kw_lattice},
               {"kw_equivalence", kw_equivalence},
+              {"grouped_test", grouped_test},
               {"half_stencil", half_stencil},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

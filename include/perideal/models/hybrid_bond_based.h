@@ -59,6 +59,15 @@ namespace PeriDEAL
      * dx = 0.25 measured no robust gain (doc/benchmarks.md, session 12).
      */
     bool half_stencil = false;
+    /**
+     * With the lattice bound (2D lattice sweeps): the exact test of a
+     * vector whose tested lanes have every bond alive takes max |y|^2 over
+     * the offsets of one bond length (no lane masks) and multiplies once
+     * per length by 1 / T^2. The same q bit for bit (the rounding of
+     * x / T^2 is monotone in x); false keeps the per-offset masked kernel
+     * (the reference of test hybrid_kw.grouped_test).
+     */
+    bool length_grouped_test = true;
   };
 
   /**
@@ -515,6 +524,12 @@ namespace PeriDEAL
      */
     std::vector<std::uint8_t>  sweep_live;
     bool                       sweep_live_valid = false;
+    /**
+     * Per vector: the lanes whose bit is set at every offset (all bonds
+     * alive; the AND of the vector's bytes of sweep_live, kept with it), so
+     * that the exact test picks its kernel without reading the bits.
+     */
+    std::vector<std::uint8_t>  full_lanes;
     /** p = x - x_c + u and u over the box (dim arrays of sweep_n_alloc). */
     std::vector<double> sweep_p, sweep_u;
     /** x - x_c over the box (layout of sweep_p). */
@@ -597,6 +612,14 @@ namespace PeriDEAL
     std::vector<float>         lip_ex, lip_ey, lip_fy;
     std::array<std::vector<std::uint8_t>, 2> lip_edge_ok;
     std::vector<unsigned int>  all_offsets;
+    /**
+     * The offsets grouped by equal 1 / T^2 (length_grouped_test): linear
+     * offsets, group starts, 1 / T^2 per group; on.
+     */
+    std::vector<std::int64_t>  grouped_offset;
+    std::vector<std::uint32_t> group_start;
+    std::vector<double>        group_iL2;
+    bool                       grouped_on = false;
     bool                       lip_have_prev = false, lip_swap_pending = false;
     /** @} */
     unsigned int        n_evaluations = 0;
