@@ -23,8 +23,12 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/tria.h>
+
 #include <perideal/abc/ebf_wave_abc.h>
 #include <perideal/base/exceptions.h>
+#include <perideal/fem/fem_wave.h>
 #include <perideal/io/plot.h>
 
 #include <cmath>
@@ -46,6 +50,8 @@ namespace Step7
     double       radius = 8., end_time = 16., dx = 0.25, dt = 0.02;
     unsigned int horizon_factor = 6, n_samples = 16;
     double       t_1d = 25., half_length_e12c = 10., t_e12c = 15.;
+    /** FEM near field (E13): half width, mesh size, time step, end time, curvature radius of the modes. */
+    double       fem_half_width = 16., fem_h = 0.5, fem_dt = 0.02, fem_end_time = 32., fem_curvature = 64.;
     std::string  output_directory = "step-7-output";
     WaveAbcParameters abc;
   };
@@ -96,10 +102,24 @@ namespace Step7
       prm.declare_entry("End time E12c", "15", Patterns::Double(0.));
       prm.declare_entry("Output directory", "step-7-output", Patterns::Anything());
       prm.leave_subsection();
+      prm.enter_subsection("FEM");
+      prm.declare_entry("Half width", "16", Patterns::Double(0.));
+      prm.declare_entry("Mesh size", "0.5", Patterns::Double(0.));
+      prm.declare_entry("Time step", "0.02", Patterns::Double(0.));
+      prm.declare_entry("End time", "32", Patterns::Double(0.));
+      prm.declare_entry("Curvature radius", "64", Patterns::Double(0.));
+      prm.leave_subsection();
       prm.enter_subsection("Absorbing boundary");
       WaveAbcParameters::declare_parameters(prm);
       prm.leave_subsection();
       prm.parse_input(file);
+      prm.enter_subsection("FEM");
+      p.fem_half_width = prm.get_double("Half width");
+      p.fem_h          = prm.get_double("Mesh size");
+      p.fem_dt         = prm.get_double("Time step");
+      p.fem_end_time   = prm.get_double("End time");
+      p.fem_curvature  = prm.get_double("Curvature radius");
+      prm.leave_subsection();
       prm.enter_subsection("Problem");
       p.radius           = prm.get_double("Near-field radius");
       p.end_time         = prm.get_double("End time");
@@ -119,6 +139,16 @@ namespace Step7
     const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
     if (root)
       std::filesystem::create_directories(p.output_directory);
+    // A csv file with its header line on the root rank (closed elsewhere).
+    const auto csv = [&](const std::string &name, const std::string &header) {
+      std::ofstream out;
+      if (root)
+        {
+          out.open(p.output_directory + "/" + name);
+          out << header << '\n';
+        }
+      return out;
+    };
     int        failures = 0;
     const auto check    = [&](const bool ok, const std::string &what) {
       if (root)
@@ -180,12 +210,7 @@ namespace Step7
       std::string s;
       const unsigned int n = 100;
       const auto ref  = energies<1>(far, lp, mp, WaveTruncation::free, abc, u0, p.t_1d, n, inside, s);
-      std::ofstream out;
-      if (root)
-        {
-          out.open(p.output_directory + "/modes_1d.csv");
-          out << "n_b,discrete,local\n";
-        }
+      std::ofstream out = csv("modes_1d.csv", "n_b,discrete,local");
       for (unsigned int nb = 1; nb <= 5; ++nb)
         {
           double err[2];
@@ -247,12 +272,7 @@ namespace Step7
         return m;
       };
       const unsigned int n_steps = static_cast<unsigned int>(std::round(T / mp.time_step)), n = 30;
-      std::ofstream      out;
-      if (root)
-        {
-          out.open(p.output_directory + "/e12c.csv");
-          out << "t,ABC,free\n";
-        }
+      std::ofstream out = csv("e12c.csv", "t,ABC,free");
       double err = 0., err_free = 0.;
       for (unsigned int s = 1; s <= n_steps; ++s)
         {
@@ -277,6 +297,74 @@ namespace Step7
                                     std::to_string(err) + " vs " + std::to_string(err_free) + ")");
     }
 
+    // 2D FEM near field (E13, Sect. 4.2.5): (-L, L)^2, FE_Q(1), lumped mass,
+    // velocity Verlet; the EBF ABC with curved modes of the discrete
+    // relation vs the conventional first-order ABC (4.75) vs a homogeneous
+    // Dirichlet reference on (-L_ref, L_ref)^2.
+    {
+      const double           L = p.fem_half_width, T = p.fem_end_time;
+      Fem::FemWaveParameters fp;
+      fp.damping   = 0.0125;
+      fp.time_step = p.fem_dt;
+      WaveAbcParameters abc; // E13's settings, not the PD ones above
+      abc.wave_number_range = 1.;
+      abc.dispersion        = "discrete";
+      abc.cone_angle        = 0.5;
+      abc.direction_range   = M_PI / 8.; // Delta phi <= pi/8 (Sect. 4.3)
+      abc.curvature_radius  = p.fem_curvature;
+      // The pulse has radius ~6; nothing reflected at L_ref is back in
+      // (-L, L)^2 before T.
+      const double     L_ref = 0.5 * (T + L + 6.) + 3.;
+      Triangulation<2> near, far;
+      GridGenerator::subdivided_hyper_cube(near, static_cast<unsigned int>(std::round(2. * L / p.fem_h)), -L, L);
+      GridGenerator::subdivided_hyper_cube(far, static_cast<unsigned int>(std::round(2. * L_ref / p.fem_h)), -L_ref, L_ref);
+      const ScalarFunctionFromFunctionObject<2> u0(
+        [](const Point<2> &x) { return std::exp(-std::log(2.) * x.square() / 9.); });
+      Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, abc, u0);
+      Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, abc, u0);
+      Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, abc, u0);
+      const auto inside = [&](const Point<2> &x) { return std::max(std::abs(x[0]), std::abs(x[1])) < L - 1e-9; };
+      const double       e0      = ref.energy(inside);
+      const unsigned int n_steps = static_cast<unsigned int>(std::round(T / p.fem_dt)), n = 32;
+      std::ofstream out = csv("fem_2d.csv", "t,reference,first-order,EBF,|EBF-ref|,|first-ref|");
+      double     de_ebf = 0., de_first = 0.;
+      const auto sample = [&]() {
+        const double er = ref.energy(inside), ef = first.energy(inside), ee = ebf.energy(inside);
+        de_ebf   = std::max(de_ebf, std::abs(ee - er) / e0);
+        de_first = std::max(de_first, std::abs(ef - er) / e0);
+        if (root)
+          out << ref.time() << ',' << er / e0 << ',' << ef / e0 << ',' << ee / e0 << ',' << std::abs(ee - er) / e0
+              << ',' << std::abs(ef - er) / e0 << '\n';
+      };
+      sample();
+      for (unsigned int s = 1; s <= n_steps; ++s)
+        {
+          ref.advance();
+          first.advance();
+          ebf.advance();
+          if (s % std::max(1u, n_steps / n) == 0 || s == n_steps)
+            sample();
+        }
+      // Field error at T: max over the near-field vertices (max u0 = 1).
+      double du_ebf = 0., du_first = 0.;
+      for (const auto &v : near.get_vertices())
+        {
+          const double ur = ref.value_at(v);
+          du_ebf          = std::max(du_ebf, std::abs(ebf.value_at(v) - ur));
+          du_first        = std::max(du_first, std::abs(first.value_at(v) - ur));
+        }
+      const auto &st = ebf.absorbing_boundary().statistics();
+      if (root)
+        std::cout << "2D FEM: (-" << L << ", " << L << ")^2, h = " << p.fem_h << ", t = " << T << ", rho = "
+                  << p.fem_curvature << "; " << st.n_absorbing << " absorbing DoFs, max cond "
+                  << st.max_condition_number << ", max |V| " << st.max_update_norm
+                  << "\n  max |E - E_ref|/E0: EBF " << de_ebf << ", first-order " << de_first << " ("
+                  << de_first / de_ebf << "x)\n  max |u - u_ref| at t_end: EBF " << du_ebf << ", first-order "
+                  << du_first << " (" << du_first / du_ebf << "x)" << std::endl;
+      check(de_ebf < de_first, "2D FEM: EBF closer to the reference in energy than the first-order ABC (" +
+                                 std::to_string(de_ebf) + " vs " + std::to_string(de_first) + ")");
+    }
+
     if (root)
       {
         std::ostringstream gp;
@@ -292,6 +380,13 @@ namespace Step7
            << "set logscale y\nset xlabel 't'\nset ylabel 'max |u - u_ref| / max |u_0| in |x| < L - delta'\n"
            << "plot for [i=2:3] '" << p.output_directory << "/e12c.csv' using 1:i with linespoints lw 2\n";
         run_gnuplot(p.output_directory + "/e12c.gp", g1.str(), p.output_directory + "/e12c.png");
+        std::ostringstream g2;
+        g2 << gnuplot_png_preamble(p.output_directory + "/fem_2d.png")
+           << "set datafile separator ','\nset key autotitle columnhead bottom left\n"
+           << "set logscale y\nset yrange [1e-6:2]\nset xlabel 't'\n"
+           << "set ylabel 'E(t)/E_ref(0) and |E - E_ref|/E_ref(0) in (-L, L)^2'\n"
+           << "plot for [i=2:6] '" << p.output_directory << "/fem_2d.csv' using 1:i with linespoints lw 2\n";
+        run_gnuplot(p.output_directory + "/fem_2d.gp", g2.str(), p.output_directory + "/fem_2d.png");
       }
     return failures == 0 ? 0 : 1;
   }
