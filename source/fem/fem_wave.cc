@@ -21,6 +21,49 @@ namespace PeriDEAL
 {
   namespace Fem
   {
+    void
+    FemWaveParameters::declare_parameters(ParameterHandler &prm)
+    {
+      const FemWaveParameters d;
+      prm.declare_entry("Degree", std::to_string(d.degree), Patterns::Integer(1, 2), "FE_Q degree.");
+      prm.declare_entry("Wave speed", "1", Patterns::Double(0.), "chi (> 0) of u_tt + 2 d u_t = chi^2 Laplace u.");
+      prm.declare_entry("Damping", "0", Patterns::Double(0.), "d >= 0.");
+      prm.declare_entry("Time step", "0", Patterns::Double(0.),
+                        "Required (> 0); velocity Verlet: at most the lumped-mass CFL bound, "
+                        "EBF ABC: at most the bound of its one-step map (both checked at setup).");
+      prm.declare_entry("Lumped mass", "true", Patterns::Bool(), "false: consistent mass (Newmark only).");
+      prm.declare_entry("Scheme", d.scheme, Patterns::Selection("velocity Verlet|Newmark"),
+                        "Explicit damped velocity Verlet (4.62) or implicit average-acceleration Newmark.");
+      prm.declare_entry("Preserve constants", "true", Patterns::Bool(),
+                        "EBF ABC: extrapolate u - u_i^n so that u = const is kept exactly.");
+      prm.declare_entry("Extrapolate velocity", "false", Patterns::Bool(),
+                        "EBF ABC: boundary velocities from V_H (4.82) (true, the source) or the "
+                        "difference quotient (false).");
+      prm.declare_entry("Layer viscosity", "0", Patterns::Double(0.),
+                        "Tangential viscosity of the boundary rings (velocity Verlet only; 0: off). "
+                        "0.2 makes Verlet + lumped mass + EBF long-run stable on squares (doc/design.md, "
+                        "session 13).");
+      prm.declare_entry("Layer width", std::to_string(d.layer_width), Patterns::Integer(1), "Rings of the layer.");
+      prm.declare_entry("Layer order", std::to_string(d.layer_order), Patterns::Integer(1, 2),
+                        "1: ring Laplacian L; 2: L M^-1 L (more selective).");
+    }
+
+    void
+    FemWaveParameters::parse_parameters(ParameterHandler &prm)
+    {
+      degree               = prm.get_integer("Degree");
+      wave_speed           = prm.get_double("Wave speed");
+      damping              = prm.get_double("Damping");
+      time_step            = prm.get_double("Time step");
+      lumped_mass          = prm.get_bool("Lumped mass");
+      scheme               = prm.get("Scheme");
+      preserve_constants   = prm.get_bool("Preserve constants");
+      extrapolate_velocity = prm.get_bool("Extrapolate velocity");
+      layer_viscosity      = prm.get_double("Layer viscosity");
+      layer_width          = prm.get_integer("Layer width");
+      layer_order          = prm.get_integer("Layer order");
+    }
+
     namespace
     {
       /** Newmark average acceleration. */
@@ -44,9 +87,9 @@ namespace PeriDEAL
       , d(prm.damping)
       , dt(prm.time_step)
     {
-      check_parameter(chi > 0., "Model/Wave speed", chi, "> 0");
-      check_parameter(d >= 0., "Model/Damping", d, ">= 0");
-      check_parameter(prm.scheme == "velocity Verlet" || prm.scheme == "Newmark", "Time stepping/Scheme",
+      check_parameter(chi > 0., "FEM/Wave speed", chi, "> 0");
+      check_parameter(d >= 0., "FEM/Damping", d, ">= 0");
+      check_parameter(prm.scheme == "velocity Verlet" || prm.scheme == "Newmark", "FEM/Scheme",
                       prm.scheme, "velocity Verlet or Newmark");
       check_parameter(lumped || newmark, "FEM/Lumped mass", std::string("false"),
                       "true with the explicit velocity Verlet (consistent mass: scheme Newmark)");
@@ -73,11 +116,11 @@ namespace PeriDEAL
       if (!newmark)
         {
           const double dt_crit = critical_time_step();
-          check_parameter(dt > 0. && dt <= dt_crit, "Time stepping/Time step", dt,
+          check_parameter(dt > 0. && dt <= dt_crit, "FEM/Time step", dt,
                           "0 < dt <= " + std::to_string(dt_crit) + " (lumped-mass Verlet bound)");
         }
       else
-        check_parameter(dt > 0., "Time stepping/Time step", dt, "> 0");
+        check_parameter(dt > 0., "FEM/Time step", dt, "> 0");
 
       for (auto *x : {&u, &v, &a, &Ku, &u_star, &v_star, &rhs, &tmp})
         x->reinit(part);

@@ -403,7 +403,7 @@ namespace
       return false;
     };
     check(rejects("velocity Verlet", false, "FEM/Lumped mass"), "consistent mass + Verlet rejected naming FEM/Lumped mass");
-    check(rejects("leapfrog", true, "Time stepping/Scheme"), "unknown scheme rejected naming Time stepping/Scheme");
+    check(rejects("leapfrog", true, "FEM/Scheme"), "unknown scheme rejected naming FEM/Scheme");
     // Curved modes need the centre x_i - rho n outside the cloud.
     bool named = false;
     try

@@ -50,8 +50,10 @@ namespace Step7
     double       radius = 8., end_time = 16., dx = 0.25, dt = 0.02;
     unsigned int horizon_factor = 6, n_samples = 16;
     double       t_1d = 25., half_length_e12c = 10., t_e12c = 15.;
-    /** FEM near field (E13): half width, mesh size, time step, end time, curvature radius of the modes. */
-    double       fem_half_width = 16., fem_h = 0.5, fem_dt = 0.02, fem_end_time = 32., fem_curvature = 64.;
+    /** FEM near field (E13): half width, mesh size, end time, curvature radius of the modes. */
+    double       fem_half_width = 16., fem_h = 0.5, fem_end_time = 32., fem_curvature = 64.;
+    /** The FEM solver's own entries (time step, damping, scheme, ...). */
+    Fem::FemWaveParameters fem;
     std::string  output_directory = "step-7-output";
     WaveAbcParameters abc;
   };
@@ -105,9 +107,9 @@ namespace Step7
       prm.enter_subsection("FEM");
       prm.declare_entry("Half width", "16", Patterns::Double(0.));
       prm.declare_entry("Mesh size", "0.5", Patterns::Double(0.));
-      prm.declare_entry("Time step", "0.02", Patterns::Double(0.));
       prm.declare_entry("End time", "32", Patterns::Double(0.));
       prm.declare_entry("Curvature radius", "64", Patterns::Double(0.));
+      Fem::FemWaveParameters::declare_parameters(prm);
       prm.leave_subsection();
       prm.enter_subsection("Absorbing boundary");
       WaveAbcParameters::declare_parameters(prm);
@@ -116,9 +118,9 @@ namespace Step7
       prm.enter_subsection("FEM");
       p.fem_half_width = prm.get_double("Half width");
       p.fem_h          = prm.get_double("Mesh size");
-      p.fem_dt         = prm.get_double("Time step");
       p.fem_end_time   = prm.get_double("End time");
       p.fem_curvature  = prm.get_double("Curvature radius");
+      p.fem.parse_parameters(prm);
       prm.leave_subsection();
       prm.enter_subsection("Problem");
       p.radius           = prm.get_double("Near-field radius");
@@ -303,9 +305,7 @@ namespace Step7
     // Dirichlet reference on (-L_ref, L_ref)^2.
     {
       const double           L = p.fem_half_width, T = p.fem_end_time;
-      Fem::FemWaveParameters fp;
-      fp.damping   = 0.0125;
-      fp.time_step = p.fem_dt;
+      const Fem::FemWaveParameters &fp = p.fem;
       WaveAbcParameters abc; // E13's settings, not the PD ones above
       abc.wave_number_range = 1.;
       abc.dispersion        = "discrete";
@@ -325,7 +325,7 @@ namespace Step7
       Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, abc, u0);
       const auto inside = [&](const Point<2> &x) { return std::max(std::abs(x[0]), std::abs(x[1])) < L - 1e-9; };
       const double       e0      = ref.energy(inside);
-      const unsigned int n_steps = static_cast<unsigned int>(std::round(T / p.fem_dt)), n = 32;
+      const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step)), n = 32;
       std::ofstream out = csv("fem_2d.csv", "t,reference,first-order,EBF,|EBF-ref|,|first-ref|");
       double     de_ebf = 0., de_first = 0.;
       const auto sample = [&]() {

@@ -2,6 +2,7 @@
 #define perideal_fem_fem_wave_h
 
 #include <deal.II/base/function.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
@@ -88,6 +89,18 @@ namespace PeriDEAL
       unsigned int layer_width = 3;
       /** Order o of the layer operator: 1 (L) or 2 (L M^-1 L, more selective). */
       unsigned int layer_order = 2;
+
+      /**
+       * Declare the entries (Degree, Wave speed, Damping, Time step, Lumped
+       * mass, Scheme, Preserve constants, Extrapolate velocity, Layer
+       * viscosity, Layer width, Layer order) in the current subsection,
+       * conventionally "FEM": FemWave's errors name them as FEM/<entry>.
+       */
+      static void
+      declare_parameters(ParameterHandler &prm);
+      /** Read the entries declared by declare_parameters(); FemWave checks the ranges. */
+      void
+      parse_parameters(ParameterHandler &prm);
     };
 
     /** Treatment of the truncation boundary of the FEM near field. */
