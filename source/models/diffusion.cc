@@ -67,6 +67,28 @@ namespace PeriDEAL
                                   weighted_row_sum_long(ci, wi, m, c);
       return kappa * (s - row_sum * c_i);
     }
+
+    // i -> (L C)_i of linear diffusion's standard row i, raw pointers taken
+    // once outside the row loops (both DiffusionOperator::apply()s).
+    template <typename Table>
+    auto
+    linear_rows(const Table                &nb,
+                const std::vector<double> &geometric_weight,
+                const std::vector<double> &row_sum,
+                const double               kappa,
+                const Vector              &C)
+    {
+      const double *const  c         = C.begin();
+      const std::int32_t  *col       = nb.col.data();
+      const std::uint64_t *row_start = nb.row_start.data();
+      const std::uint64_t *table     = nb.table_start.data();
+      const double        *gw        = geometric_weight.data();
+      const double        *rs        = row_sum.data();
+      return [=](const unsigned int i) {
+        return linear_row(col + row_start[i], gw + table[i], row_start[i + 1] - row_start[i], c,
+                          rs[i], c[i], kappa);
+      };
+    }
   } // namespace
 
   void
@@ -247,11 +269,8 @@ namespace PeriDEAL
 
     if (!corrosion)
       {
-        const double kappa = kappa_table[0];
-        for_standard_rows([&](const unsigned int i) {
-            r[i] = linear_row(col + row_start[i], gw + table[i], row_start[i + 1] - row_start[i],
-                              c, row_sum[i], c[i], kappa);
-          });
+        const auto row = linear_rows(disc.neighborhood, geometric_weight, row_sum, kappa_table[0], C);
+        for_standard_rows([&](const unsigned int i) { r[i] = row(i); });
         if (wls) // Omega_w: the WLS rows (weights carry kappa), same short-row kernel
           for (unsigned int k = 0; k < wls->node.size(); ++k)
             {
@@ -348,18 +367,11 @@ namespace PeriDEAL
   {
     AssertThrow(!corrosion && !wls,
                 ExcMessage("apply() on row ranges: linear diffusion without WLS rows only"));
-    const auto          &nb        = disc.neighborhood;
-    const double *const  c         = C.begin();
-    double *const        r         = rate.begin();
-    const std::int32_t  *col       = nb.col.data();
-    const std::uint64_t *row_start = nb.row_start.data();
-    const std::uint64_t *table     = nb.table_start.data();
-    const double        *gw        = geometric_weight.data();
-    const double         kappa     = kappa_table[0];
+    double *const r   = rate.begin();
+    const auto    row = linear_rows(disc.neighborhood, geometric_weight, row_sum, kappa_table[0], C);
     for (const auto &range : rows)
       for (unsigned int i = range[0]; i < range[1]; ++i)
-        r[i] = linear_row(col + row_start[i], gw + table[i], row_start[i + 1] - row_start[i], c,
-                          row_sum[i], c[i], kappa);
+        r[i] = row(i);
   }
 
   template <int dim>
