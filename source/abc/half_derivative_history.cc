@@ -160,6 +160,7 @@ namespace PeriDEAL
           double      *u    = states.data() + std::size_t(a) * n_exp;
           const double c    = oldest[a];
           double       tail = 0.;
+#pragma omp simd reduction(+ : tail)
           for (unsigned int k = 0; k < n_exp; ++k)
             {
               u[k] = c + decay[k] * u[k];

@@ -1072,7 +1072,8 @@ namespace
   /**
    * Exploratory scan (not a ctest case): FEMBALL_SCAN="key=value;..." with
    * shape (ball|cube|disk), fit, form, rcond, dinf, dk, nk, nphi, dt,
-   * imposed, ref, t, checksteps, kappa, distributed, rho; prints the energy
+   * imposed, ref, t, checksteps, kappa, distributed, rho, history (of the
+   * half derivative: exact or sum of exponentials); prints the energy
    * errors and the one-step spectral radius.
    */
   void
@@ -1083,7 +1084,7 @@ namespace
                                           {"rcond", "0"}, {"dinf", "0.45"}, {"dk", "0"}, {"nk", "20"},
                                           {"nphi", "5"}, {"dt", "1e-3"}, {"imposed", "value"}, {"ref", "3"},
                                           {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"},
-                                          {"rho", "0"}};
+                                          {"rho", "0"}, {"history", "sum of exponentials"}};
     std::string spec = env ? env : "";
     for (std::size_t pos = 0; pos < spec.size();)
       {
@@ -1104,6 +1105,7 @@ namespace
       ap.boundary_curvature       = kv["kappa"] == "mesh" ? 0. : std::stod(kv["kappa"]);
       ap.curvature_radius         = std::stod(kv["rho"]);
       ap.curvature_from_mesh      = kv["kappa"] == "mesh";
+      ap.half_derivative_history  = kv["history"];
       if (kv["fit"] != "monotone")
         ap.max_update_norm = 1e10;
     };
