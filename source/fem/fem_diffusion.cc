@@ -20,6 +20,32 @@ namespace PeriDEAL
 {
   namespace Fem
   {
+    void
+    FemDiffusionParameters::declare_parameters(ParameterHandler &prm)
+    {
+      const FemDiffusionParameters d;
+      prm.declare_entry("Degree", std::to_string(d.degree), Patterns::Integer(1, 2), "FE_Q degree.");
+      prm.declare_entry("Lumped mass", d.lumped_mass ? "true" : "false", Patterns::Bool(),
+                        "Lumped (Gauss-Lobatto, diagonal) or consistent mass matrix.");
+      prm.declare_entry("Scheme", d.scheme, Patterns::Selection("forward Euler|backward Euler"),
+                        "forward Euler (at most the bound 2/lambda_max(M^-1 K), checked at setup) or "
+                        "backward Euler. Imposed = normal derivative / half derivative: forward Euler "
+                        "with lumped mass.");
+      prm.declare_entry("Diffusivity", "1", Patterns::Double(0.), "D (> 0) of C_t = D Laplace C.");
+      prm.declare_entry("Time step", "0.001", Patterns::Double(0.),
+                        "> 0; forward Euler and the EBF ABC limit it (checked at setup).");
+    }
+
+    void
+    FemDiffusionParameters::parse_parameters(ParameterHandler &prm)
+    {
+      degree      = prm.get_integer("Degree");
+      lumped_mass = prm.get_bool("Lumped mass");
+      scheme      = prm.get("Scheme");
+      diffusivity = prm.get_double("Diffusivity");
+      time_step   = prm.get_double("Time step");
+    }
+
     template <int dim>
     FemDiffusion<dim>::FemDiffusion(const Triangulation<dim>     &tria,
                                     const FemDiffusionParameters &parameters)

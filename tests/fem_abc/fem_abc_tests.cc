@@ -982,6 +982,83 @@ namespace
   }
 
   /**
+   * FemDiffusionParameters through the parameter file (subsection FEM):
+   * the defaults equal the struct's, every entry is read, and bad values
+   * end in errors naming FEM/<entry> with the allowed range (the patterns
+   * reject what is outside them already while parsing).
+   */
+  void
+  diffusion_parameters()
+  {
+    const Fem::FemDiffusionParameters defaults, parsed = parameters_from_text<Fem::FemDiffusionParameters>("");
+    check(parsed.degree == defaults.degree && parsed.lumped_mass == defaults.lumped_mass &&
+            parsed.scheme == defaults.scheme && parsed.diffusivity == defaults.diffusivity &&
+            parsed.time_step == defaults.time_step,
+          "the declared defaults are the struct's");
+    const auto all = parameters_from_text<Fem::FemDiffusionParameters>(
+      "set Degree = 2\nset Lumped mass = false\nset Scheme = backward Euler\nset Diffusivity = 0.5\n"
+      "set Time step = 0.002\n");
+    check(all.degree == 2 && !all.lumped_mass && all.scheme == "backward Euler" && all.diffusivity == 0.5 &&
+            all.time_step == 0.002,
+          "every entry is read");
+    // In the FEM subsection, as an application declares it.
+    const auto from_fem = [](const std::string &entries) {
+      ParameterHandler prm;
+      prm.enter_subsection("FEM");
+      Fem::FemDiffusionParameters::declare_parameters(prm);
+      prm.leave_subsection();
+      prm.parse_input_from_string("subsection FEM\n" + entries + "end\n");
+      Fem::FemDiffusionParameters p;
+      prm.enter_subsection("FEM");
+      p.parse_parameters(prm);
+      prm.leave_subsection();
+      return p;
+    };
+    Triangulation<2> square;
+    GridGenerator::subdivided_hyper_cube(square, 8, -1., 1.);
+    const auto error = [&](const std::string &entries, const std::string &imposed) {
+      try
+        {
+          Fem::FemDiffusion<2> d(square, from_fem(entries));
+          Abc::EbfParameters   ap;
+          ap.imposed               = imposed;
+          ap.stability_check_steps = 0;
+          d.setup(imposed.empty() ? Abc::TruncationBoundary::neumann : Abc::TruncationBoundary::absorbing,
+                  imposed.empty() ? Abc::EbfParameters() : ap, RoughField());
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what());
+        }
+      return std::string();
+    };
+    const auto names = [](const std::string &msg, const std::string &entry, const std::string &range) {
+      return msg.find("'FEM/" + entry + "'") != std::string::npos && msg.find(range) != std::string::npos;
+    };
+    check(error("set Time step = 0.001\n", "").empty(), "valid entries accepted");
+    check(names(error("set Time step = 0\n", ""), "Time step", "> 0"), "Time step = 0 rejected naming FEM/Time step");
+    check(names(error("set Diffusivity = 0\n", ""), "Diffusivity", "> 0"),
+          "Diffusivity = 0 rejected naming FEM/Diffusivity");
+    check(names(error("set Time step = 1\n", ""), "Time step", "forward Euler bound"),
+          "a forward Euler step above 2/lambda_max rejected naming FEM/Time step and the bound");
+    check(names(error("set Lumped mass = false\n", "half derivative"), "Scheme", "forward Euler with lumped mass"),
+          "consistent mass with Imposed = half derivative rejected naming FEM/Scheme");
+    for (const std::string bad : {"set Degree = 3\n", "set Scheme = Crank-Nicolson\n", "set Diffusivity = -1\n"})
+      {
+        bool rejected = false;
+        try
+          {
+            from_fem(bad);
+          }
+        catch (const std::exception &)
+          {
+            rejected = true;
+          }
+        check(rejected, "'" + bad.substr(0, bad.size() - 1) + "' rejected by the entry's pattern");
+      }
+  }
+
+  /**
    * The sum-of-exponentials history of Imposed = half derivative (session
    * 14): (1) the approximation of the Gruenwald-Letnikov weights against
    * their closed form Gamma(j - 1/2) / (Gamma(-1/2) Gamma(j + 1)) (Boost's
@@ -1109,5 +1186,5 @@ namespace
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
 }

@@ -3,6 +3,7 @@
 
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/function.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
@@ -40,6 +41,17 @@ namespace PeriDEAL
       double diffusivity = 1.;
       /** Time step. */
       double time_step = 1e-3;
+
+      /**
+       * Declare the entries (Degree, Lumped mass, Scheme, Diffusivity, Time
+       * step) in the current subsection, conventionally "FEM": FemDiffusion's
+       * errors name them as FEM/<entry>.
+       */
+      static void
+      declare_parameters(ParameterHandler &prm);
+      /** Read the entries declared by declare_parameters(); FemDiffusion checks the ranges. */
+      void
+      parse_parameters(ParameterHandler &prm);
     };
 
     /**
