@@ -23,6 +23,7 @@
 #               missing)
 #   SECONDS_PER_LOOP  target wall time of each timed loop (default 1)
 #   ABC_STEPS   time steps of the ABC overhead measurement (default 2000)
+#   HALF_DERIVATIVE_ROUNDS  interleaved rounds of half_derivative_benchmark (default 3)
 #   CORROSION_STEPS  timed steps of the 3D corrosion benchmark (default 100)
 #   KW_ARGS     options of kw_multiadaptive_benchmark (default: its CI-size case)
 #   KW_HYBRID_ARGS  options of kw_hybrid_benchmark (default "--dx 0.25 --m 8",
@@ -66,7 +67,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPERIDEAL_BUILD_BENCHMARKS=ON \
     -DPERIDEAL_ENABLE_TESTS=OFF > "$build/benchmark-configure.log" 2>&1 \
     || { cat "$build/benchmark-configure.log" >&2; exit 1; }
-  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark kw_hybrid_benchmark fem_abc_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
+  cmake --build "$build" --target diffusion_benchmark pmb_benchmark abc_benchmark corrosion_benchmark kw_multiadaptive_benchmark kw_hybrid_benchmark fem_abc_benchmark half_derivative_benchmark -j"$jobs" > "$build/benchmark-build.log" 2>&1 \
     || { tail -60 "$build/benchmark-build.log" >&2; exit 1; }
 fi
 exe="$build/contrib/benchmarks/diffusion_benchmark"
@@ -353,6 +354,12 @@ if [ -n "$kw_hybrid_args" ] && [ -x "$kw_hybrid_exe" ]; then
   # shellcheck disable=SC2086
   ( cd "$build" && "$kw_hybrid_exe" $kw_hybrid_args --directory "$build/kw-hybrid-benchmark" ) \
     | grep '^kw_' | tee -a "$results"
+fi
+
+# Half-derivative ABC history: exact vs sum of exponentials, CPU us per step.
+half_exe="$build/contrib/benchmarks/half_derivative_benchmark"
+if [ -x "$half_exe" ]; then
+  "$half_exe" --rounds "${HALF_DERIVATIVE_ROUNDS:-3}" | grep '^half_derivative_' | tee -a "$results"
 fi
 
 echo "machine_load_average_after: $(cut -d' ' -f1 /proc/loadavg)" | tee -a "$results"

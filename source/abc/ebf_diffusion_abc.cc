@@ -212,6 +212,18 @@ namespace PeriDEAL
       prm.declare_entry("Boundary curvature from mesh", "false", Patterns::Bool(),
                         "Imposed = half derivative (FEM): estimate the curvature per boundary DoF from "
                         "the adjacent boundary faces' normals instead of Boundary curvature.");
+      prm.declare_entry("Half derivative history", "sum of exponentials",
+                        Patterns::Selection("exact|sum of exponentials"),
+                        "Imposed = half derivative: exact (every past level, O(n) per step) or sum of "
+                        "exponentials (the last exact steps exactly, the older ones by exponentials with "
+                        "relative accuracy Half derivative accuracy, O(1) per step).");
+      prm.declare_entry("Half derivative accuracy", "1e-10", Patterns::Double(0.),
+                        "sum of exponentials: relative accuracy of the weights (1e-13 .. 1e-3).");
+      prm.declare_entry("Half derivative exact steps", "5", Patterns::Integer(0),
+                        "sum of exponentials: the most recent levels summed exactly (0 .. 1000).");
+      prm.declare_entry("Half derivative horizon", "1e6", Patterns::Double(0.),
+                        "sum of exponentials: the number of steps over which the accuracy holds "
+                        "(> exact steps, <= 1e15).");
       prm.declare_entry("Maximum updating vector l1 norm", "1e10", Patterns::Double(1.),
                         "Optional guard on sum_j |V_j| (least-squares fit; 1 demands the "
                         "sufficient stability bound).");
@@ -254,6 +266,10 @@ namespace PeriDEAL
       boundary_curvature       = prm.get_double("Boundary curvature");
       curvature_radius         = prm.get_double("Curvature radius");
       curvature_from_mesh      = prm.get_bool("Boundary curvature from mesh");
+      half_derivative_history     = prm.get("Half derivative history");
+      half_derivative_accuracy    = prm.get_double("Half derivative accuracy");
+      half_derivative_exact_steps = prm.get_integer("Half derivative exact steps");
+      half_derivative_horizon     = prm.get_double("Half derivative horizon");
       check_parameter(cloud_radius > 0., "Absorbing boundary/Cloud radius", cloud_radius, "> 0");
       check_parameter(fit == "least squares" || fit == "monotone" || fit == "bounded" ||
                         fit == "stabilized" || fit == "sink",

@@ -20,6 +20,32 @@ namespace PeriDEAL
 {
   namespace Fem
   {
+    void
+    FemDiffusionParameters::declare_parameters(ParameterHandler &prm)
+    {
+      const FemDiffusionParameters d;
+      prm.declare_entry("Degree", std::to_string(d.degree), Patterns::Integer(1, 2), "FE_Q degree.");
+      prm.declare_entry("Lumped mass", d.lumped_mass ? "true" : "false", Patterns::Bool(),
+                        "Lumped (Gauss-Lobatto, diagonal) or consistent mass matrix.");
+      prm.declare_entry("Scheme", d.scheme, Patterns::Selection("forward Euler|backward Euler"),
+                        "forward Euler (at most the bound 2/lambda_max(M^-1 K), checked at setup) or "
+                        "backward Euler. Imposed = normal derivative / half derivative: forward Euler "
+                        "with lumped mass.");
+      prm.declare_entry("Diffusivity", "1", Patterns::Double(0.), "D (> 0) of C_t = D Laplace C.");
+      prm.declare_entry("Time step", "0.001", Patterns::Double(0.),
+                        "> 0; forward Euler and the EBF ABC limit it (checked at setup).");
+    }
+
+    void
+    FemDiffusionParameters::parse_parameters(ParameterHandler &prm)
+    {
+      degree      = prm.get_integer("Degree");
+      lumped_mass = prm.get_bool("Lumped mass");
+      scheme      = prm.get("Scheme");
+      diffusivity = prm.get_double("Diffusivity");
+      time_step   = prm.get_double("Time step");
+    }
+
     template <int dim>
     FemDiffusion<dim>::FemDiffusion(const Triangulation<dim>     &tria,
                                     const FemDiffusionParameters &parameters)
@@ -81,13 +107,15 @@ namespace PeriDEAL
           flux_weight.local_element(l) = prm.diffusivity * boundary_lumped.local_element(l) /
                                          lumped.local_element(l);
       half_dofs.clear();
-      half_history.clear();
-      n_history_levels = 0;
+      half_history = Abc::HalfDerivativeHistory();
       if (half_derivative)
         {
           check_parameter(abc_parameters.boundary_curvature >= 0., "Absorbing boundary/Boundary curvature",
                           abc_parameters.boundary_curvature, ">= 0");
           half_dofs = absorbing_dofs;
+          half_history.reinit(half_dofs.size(), abc_parameters.half_derivative_history,
+                              abc_parameters.half_derivative_accuracy, abc_parameters.half_derivative_exact_steps,
+                              abc_parameters.half_derivative_horizon);
           // Or the mesh's estimate per DoF (NearFieldLayout::curvatures),
           // clipped at 0 (the flux stays a sink on concave parts).
           half_curvature.assign(half_dofs.size(), abc_parameters.boundary_curvature);
@@ -106,7 +134,12 @@ namespace PeriDEAL
           // forward Euler map with natural boundary is nonnegative (K_ij <= 0,
           // dt <= m_i / K_ii) max |C| over the run cannot grow, provided the
           // C_i^n coefficient 1 - dt K_ii/m_i + w sqrt(dt/D)/2 is >= 0 (so the
-          // bound checked here is the weakest such). With x = sqrt(dt):
+          // bound checked here is the weakest such). The sum-of-exponentials
+          // history keeps this: its weights are negative too (w_k < 0) and
+          // within relative accuracy eps of g_j over the horizon, so the
+          // partial sums (1/sqrt(pi m) for large m) stay >= 1/sqrt(pi m) - eps
+          // > 0 for m < min(horizon, 1/(pi eps^2)) (1e6 steps at the default
+          // 1e-10; beyond, the argument no longer covers it). With x = sqrt(dt):
           // a x^2 - b x / 2 <= 1, a = K_ii / m_i, b = w / sqrt(D).
           double dt_max = std::numeric_limits<double>::max();
           for (const unsigned int l : half_dofs)
@@ -322,26 +355,14 @@ namespace PeriDEAL
     FemDiffusion<dim>::half_derivative_flux()
     {
       // The history part of the Gruenwald-Letnikov half derivative at
-      // t^{n+1}, dt^{-1/2} sum_{j=0}^{n+1} g_j C^{n+1-j}, g_0 = 1, g_j =
-      // g_{j-1} (j - 3/2) / j (Riemann-Liouville, first order in dt): the
-      // sum over j >= 1 (levels n .. 0); the j = 0 term is taken implicitly
-      // in advance(). The whole history is summed: O(n) per step and DoF.
-      const unsigned int nb = half_dofs.size();
-      for (const unsigned int l : half_dofs)
-        half_history.push_back(C.local_element(l));
-      const unsigned int n = n_history_levels++;
-      while (gl_weights.size() <= n + 1)
-        {
-          const double j = gl_weights.size();
-          gl_weights.push_back(j == 0 ? 1. : gl_weights.back() * (j - 1.5) / j);
-        }
-      boundary_values.assign(nb, 0.);
-      for (unsigned int j = 1; j <= n + 1; ++j)
-        {
-          const double *level = half_history.data() + std::size_t(n + 1 - j) * nb;
-          for (unsigned int a = 0; a < nb; ++a)
-            boundary_values[a] += gl_weights[j] * level[a];
-        }
+      // t^{n+1}, dt^{-1/2} sum_{j=0}^{n+1} g_j C^{n+1-j} (Riemann-Liouville,
+      // first order in dt): the sum over j >= 1 (levels n .. 0), exact or by
+      // sums of exponentials (Abc::HalfDerivativeHistory); the j = 0 term is
+      // taken implicitly in advance().
+      half_values.resize(half_dofs.size());
+      for (unsigned int a = 0; a < half_dofs.size(); ++a)
+        half_values[a] = C.local_element(half_dofs[a]);
+      half_history.append(half_values.data(), boundary_values);
     }
 
     template <int dim>

@@ -11,6 +11,7 @@
 #include <deal.II/grid/tria.h>
 
 #include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/abc/half_derivative_history.h>
 #include <perideal/base/exceptions.h>
 #include <perideal/fem/fem_diffusion.h>
 #include <perideal/fem/fem_wave.h>
@@ -21,7 +22,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
+#include <functional>
 #include <memory>
+#include <random>
 #include <sstream>
 
 using namespace dealii;
@@ -977,10 +980,211 @@ namespace
     check(d_full < 1e-10, "increment = value form without a cut (" + sci(d_full) + ")");
     check(d_cut > 1e-3, "increment != value form under rcond 1e-2 (" + sci(d_cut) + ")");
   }
+
+  /**
+   * FemDiffusionParameters through the parameter file (subsection FEM):
+   * the defaults equal the struct's, every entry is read, and bad values
+   * end in errors naming FEM/<entry> with the allowed range (the patterns
+   * reject what is outside them already while parsing).
+   */
+  void
+  diffusion_parameters()
+  {
+    const Fem::FemDiffusionParameters defaults, parsed = parameters_from_text<Fem::FemDiffusionParameters>("");
+    check(parsed.degree == defaults.degree && parsed.lumped_mass == defaults.lumped_mass &&
+            parsed.scheme == defaults.scheme && parsed.diffusivity == defaults.diffusivity &&
+            parsed.time_step == defaults.time_step,
+          "the declared defaults are the struct's");
+    const auto all = parameters_from_text<Fem::FemDiffusionParameters>(
+      "set Degree = 2\nset Lumped mass = false\nset Scheme = backward Euler\nset Diffusivity = 0.5\n"
+      "set Time step = 0.002\n");
+    check(all.degree == 2 && !all.lumped_mass && all.scheme == "backward Euler" && all.diffusivity == 0.5 &&
+            all.time_step == 0.002,
+          "every entry is read");
+    // In the FEM subsection, as an application declares it.
+    const auto from_fem = [](const std::string &entries) {
+      ParameterHandler prm;
+      prm.enter_subsection("FEM");
+      Fem::FemDiffusionParameters::declare_parameters(prm);
+      prm.leave_subsection();
+      prm.parse_input_from_string("subsection FEM\n" + entries + "end\n");
+      Fem::FemDiffusionParameters p;
+      prm.enter_subsection("FEM");
+      p.parse_parameters(prm);
+      prm.leave_subsection();
+      return p;
+    };
+    Triangulation<2> square;
+    GridGenerator::subdivided_hyper_cube(square, 8, -1., 1.);
+    const auto error = [&](const std::string &entries, const std::string &imposed) {
+      try
+        {
+          Fem::FemDiffusion<2> d(square, from_fem(entries));
+          Abc::EbfParameters   ap;
+          ap.imposed               = imposed;
+          ap.stability_check_steps = 0;
+          d.setup(imposed.empty() ? Abc::TruncationBoundary::neumann : Abc::TruncationBoundary::absorbing,
+                  imposed.empty() ? Abc::EbfParameters() : ap, RoughField());
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what());
+        }
+      return std::string();
+    };
+    const auto names = [](const std::string &msg, const std::string &entry, const std::string &range) {
+      return msg.find("'FEM/" + entry + "'") != std::string::npos && msg.find(range) != std::string::npos;
+    };
+    check(error("set Time step = 0.001\n", "").empty(), "valid entries accepted");
+    check(names(error("set Time step = 0\n", ""), "Time step", "> 0"), "Time step = 0 rejected naming FEM/Time step");
+    check(names(error("set Diffusivity = 0\n", ""), "Diffusivity", "> 0"),
+          "Diffusivity = 0 rejected naming FEM/Diffusivity");
+    check(names(error("set Time step = 1\n", ""), "Time step", "forward Euler bound"),
+          "a forward Euler step above 2/lambda_max rejected naming FEM/Time step and the bound");
+    check(names(error("set Lumped mass = false\n", "half derivative"), "Scheme", "forward Euler with lumped mass"),
+          "consistent mass with Imposed = half derivative rejected naming FEM/Scheme");
+    for (const std::string bad : {"set Degree = 3\n", "set Scheme = Crank-Nicolson\n", "set Diffusivity = -1\n"})
+      {
+        bool rejected = false;
+        try
+          {
+            from_fem(bad);
+          }
+        catch (const std::exception &)
+          {
+            rejected = true;
+          }
+        check(rejected, "'" + bad.substr(0, bad.size() - 1) + "' rejected by the entry's pattern");
+      }
+  }
+
+  /**
+   * The sum-of-exponentials history of Imposed = half derivative (session
+   * 14): (1) the approximation of the Gruenwald-Letnikov weights against
+   * their closed form Gamma(j - 1/2) / (Gamma(-1/2) Gamma(j + 1)) (Boost's
+   * Gamma ratio, not the recurrence of the exact history nor the Laplace
+   * integral of the approximation) at every j of [exact steps + 1,
+   * horizon]: relative error <= the stated accuracy; beyond the horizon
+   * the absolute error <= accuracy |g_horizon|. (2) The recursive history
+   * against the exact sum on random levels: since sum_{j >= 1} |g_j| = 1,
+   * |H_soe - H_exact| <= accuracy max_m |C^m| at every step. (3) Bad input
+   * names the parameter and its range.
+   */
+  void
+  half_derivative_soe()
+  {
+    struct Case
+    {
+      double       accuracy;
+      unsigned int exact_steps;
+      double       horizon;
+    };
+    for (const Case c : {Case{1e-10, 5, 1e5}, Case{1e-8, 0, 3e4}, Case{1e-13, 1, 2e4}, Case{1e-3, 1000, 5e4}})
+      {
+        const Abc::HalfDerivativeSoe soe(c.accuracy, c.exact_steps, c.horizon);
+        double                       rel = 0., beyond = 0.;
+        for (std::size_t j = c.exact_steps + 1; j <= std::size_t(c.horizon); ++j)
+          {
+            const double g = Abc::gruenwald_letnikov_half_weight(j);
+            rel            = std::max(rel, std::abs(soe.weight(j) - g) / std::abs(g));
+          }
+        const double g_horizon = std::abs(Abc::gruenwald_letnikov_half_weight(std::size_t(c.horizon)));
+        for (double j = c.horizon; j <= 1e3 * c.horizon; j *= 1.01)
+          beyond = std::max(beyond, std::abs(soe.weight(std::size_t(j)) -
+                                             Abc::gruenwald_letnikov_half_weight(std::size_t(j))) / g_horizon);
+        const std::string name = "accuracy " + sci(c.accuracy) + ", exact steps " + std::to_string(c.exact_steps) +
+                                 ", horizon " + sci(c.horizon) + ": " + std::to_string(soe.rates.size()) +
+                                 " exponentials";
+        check(rel <= c.accuracy, name + ", max relative error " + sci(rel) + " on every j of the range");
+        check(beyond <= c.accuracy, name + ", beyond the horizon (to 1e3 x) max |error| / |g_horizon| " +
+                                      sci(beyond));
+      }
+    // The exact history's recurrence against the closed form (its round-off).
+    {
+      double g = 1., rel = 0.;
+      for (std::size_t j = 1; j <= 100000; ++j)
+        {
+          g *= (j - 1.5) / j;
+          rel = std::max(rel, std::abs(g / Abc::gruenwald_letnikov_half_weight(j) - 1.));
+        }
+      check(rel < 1e-12, "recurrence g_j = g_{j-1} (j - 3/2) / j = closed form to " + sci(rel) + " (j <= 1e5)");
+    }
+
+    // (2) The two histories on the same random levels (7 points, 4000 steps).
+    {
+      const unsigned int         n_dofs = 7;
+      Abc::HalfDerivativeHistory exact, fast;
+      exact.reinit(n_dofs, "exact", 1e-10, 5, 1e6);
+      fast.reinit(n_dofs, "sum of exponentials", 1e-10, 5, 1e6);
+      std::minstd_rand                       gen(7);
+      std::uniform_real_distribution<double> uniform(-1., 1.);
+      std::vector<double>                    c(n_dofs), he, hf;
+      double                                 worst = 0., c_max = 0., h_max = 0.;
+      for (unsigned int n = 0; n < 4000; ++n)
+        {
+          for (unsigned int a = 0; a < n_dofs; ++a)
+            c[a] = (a % 2 ? uniform(gen) : std::cos(0.003 * n * (a + 1))), c_max = std::max(c_max, std::abs(c[a]));
+          exact.append(c.data(), he);
+          fast.append(c.data(), hf);
+          for (unsigned int a = 0; a < n_dofs; ++a)
+            worst = std::max(worst, std::abs(he[a] - hf[a]) / c_max), h_max = std::max(h_max, std::abs(he[a]));
+        }
+      check(worst <= 1e-10 && h_max > 0.1,
+            "sum of exponentials vs exact history, 4000 random levels: max |H_soe - H_exact| / max |C| = " +
+              sci(worst) + " <= 1e-10 (" + std::to_string(fast.n_exponentials()) + " exponentials, max |H| " +
+              sci(h_max) + ")");
+    }
+
+    // (3) Bad input, directly, through the parameter file and the setup.
+    const auto error = [](const std::function<void()> &f) {
+      try
+        {
+          f();
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what());
+        }
+      return std::string();
+    };
+    const auto names = [](const std::string &msg, const std::string &parameter, const std::string &range) {
+      return msg.find("'Absorbing boundary/Half derivative " + parameter + "'") != std::string::npos &&
+             msg.find(range) != std::string::npos;
+    };
+    Abc::HalfDerivativeHistory h;
+    for (const double a : {0., 1e-14, 1e-2})
+      check(names(error([&]() { h.reinit(1, "sum of exponentials", a, 5, 1e6); }), "accuracy",
+                  "1e-13 <= accuracy <= 1e-3"),
+            "accuracy " + sci(a) + " rejected naming Half derivative accuracy and its range");
+    check(names(error([&]() { h.reinit(1, "sum of exponentials", 1e-10, 1001, 1e6); }), "exact steps",
+                "0 <= exact steps <= 1000"),
+          "1001 exact steps rejected naming Half derivative exact steps and its range");
+    check(names(error([&]() { h.reinit(1, "sum of exponentials", 1e-10, 5, 5); }), "horizon",
+                "exact steps < horizon <= 1e15"),
+          "horizon 5 with 5 exact steps rejected naming Half derivative horizon");
+    check(names(error([&]() { h.reinit(1, "fast", 1e-10, 5, 1e6); }), "history", "exact or sum of exponentials"),
+          "an unknown history rejected naming Half derivative history");
+    Triangulation<2> square;
+    GridGenerator::subdivided_hyper_cube(square, 8, -1., 1.);
+    const auto ap = parameters_from_text<Abc::EbfParameters>("set Imposed = half derivative\n"
+                                                              "set Half derivative accuracy = 0.1\n");
+    Fem::FemDiffusionParameters fp;
+    fp.time_step = 1e-3;
+    Fem::FemDiffusion<2> d(square, fp);
+    check(names(error([&]() { d.setup(Abc::TruncationBoundary::absorbing, ap, RoughField()); }), "accuracy",
+                "<= 1e-3"),
+          "Half derivative accuracy = 0.1 from the parameter file rejected by the setup, naming the entry");
+    auto exact = parameters_from_text<Abc::EbfParameters>("set Imposed = half derivative\n"
+                                                          "set Half derivative history = exact\n");
+    d.setup(Abc::TruncationBoundary::absorbing, exact, RoughField());
+    check(d.half_derivative_history().n_exponentials() == 0 &&
+            parameters_from_text<Abc::EbfParameters>("").half_derivative_history == "sum of exponentials",
+          "Half derivative history = exact is read (default: sum of exponentials)");
+  }
 } // namespace
 
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
 }

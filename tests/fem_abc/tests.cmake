@@ -1,5 +1,5 @@
 perideal_add_test_program(fem_abc_tests ${CMAKE_CURRENT_LIST_DIR}/fem_abc_tests.cc)
-foreach(_t constant_state spectral_radius bad_input backward_euler_guard half_derivative)
+foreach(_t constant_state spectral_radius bad_input backward_euler_guard half_derivative half_derivative_soe diffusion_parameters)
   perideal_add_test(NAME fem_abc.${_t} COMMAND $<TARGET_FILE:fem_abc_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME fem_abc.e13 COMMAND $<TARGET_FILE:fem_abc_tests> e13 LABELS convergence)

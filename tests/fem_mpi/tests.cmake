@@ -9,3 +9,5 @@ foreach(_t disk_diffusion disk_wave)
 endforeach()
 # 3D FEM diffusion with the EBF ABC (octant frame) on a cube and a ball vs the heat kernel.
 perideal_add_test(NAME fem_mpi.diffusion_3d_cube_ball COMMAND $<TARGET_FILE:fem_mpi_tests> diffusion_3d_cube_ball LABELS convergence)
+# Session 14: the half-derivative ABC's sum-of-exponentials history vs the exact sum (disk, 6000 steps).
+perideal_add_test(NAME fem_mpi.half_derivative_history COMMAND $<TARGET_FILE:fem_mpi_tests> half_derivative_history LABELS convergence)

@@ -101,6 +101,22 @@ namespace PeriDEAL
        * (Fem::NearFieldLayout::curvatures, clipped at 0).
        */
       bool curvature_from_mesh = false;
+      /**
+       * Imposed = "half derivative" (FEM): how the Gruenwald-Letnikov
+       * history is summed (Abc::HalfDerivativeHistory). "exact": every
+       * past level, O(n) per step and boundary DoF. "sum of exponentials":
+       * the last half_derivative_exact_steps levels exactly, the older ones
+       * by a sum of exponentials of the weights with relative accuracy
+       * half_derivative_accuracy over half_derivative_horizon steps, O(1)
+       * per step (92 exponentials at 1e-10, 5 exact steps, 1e6 steps).
+       */
+      std::string half_derivative_history = "sum of exponentials";
+      /** "sum of exponentials": relative accuracy of the weights, 1e-13 .. 1e-3. */
+      double half_derivative_accuracy = 1e-10;
+      /** "sum of exponentials": the most recent levels summed exactly, 0 .. 1000. */
+      unsigned int half_derivative_exact_steps = 5;
+      /** "sum of exponentials": steps over which the accuracy holds (beyond: absolute error below accuracy |g_horizon| per weight). */
+      double half_derivative_horizon = 1e6;
       /** "bounded" fit: V_j >= -lower_bound (a negative value: no bound). */
       double lower_bound = -1.;
       /**

@@ -3,6 +3,7 @@
 
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/function.h>
+#include <deal.II/base/parameter_handler.h>
 
 #include <deal.II/dofs/dof_handler.h>
 
@@ -15,6 +16,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
 #include <perideal/abc/ebf_diffusion_abc.h>
+#include <perideal/abc/half_derivative_history.h>
 #include <perideal/abc/pd_unbounded_diffusion.h>
 #include <perideal/fem/near_field.h>
 
@@ -39,6 +41,17 @@ namespace PeriDEAL
       double diffusivity = 1.;
       /** Time step. */
       double time_step = 1e-3;
+
+      /**
+       * Declare the entries (Degree, Lumped mass, Scheme, Diffusivity, Time
+       * step) in the current subsection, conventionally "FEM": FemDiffusion's
+       * errors name them as FEM/<entry>.
+       */
+      static void
+      declare_parameters(ParameterHandler &prm);
+      /** Read the entries declared by declare_parameters(); FemDiffusion checks the ranges. */
+      void
+      parse_parameters(ParameterHandler &prm);
     };
 
     /**
@@ -73,8 +86,10 @@ namespace PeriDEAL
        * the boundary DoFs keep their FEM rows with the flux dC/dn =
        * -(kappa/2) C - D^{-1/2} d^{1/2}C/dt^{1/2} of their own history
        * (Gruenwald-Letnikov, the current level implicitly; no clouds and no
-       * one-step check, the map has memory), and the step must keep the
-       * boundary rows nonnegative (ParameterError naming FEM/Time step).
+       * one-step check, the map has memory; the history exact or by sums of
+       * exponentials, EbfParameters::half_derivative_history), and the step
+       * must keep the boundary rows nonnegative (ParameterError naming
+       * FEM/Time step).
        * The "stabilized" fit blends by
        * Abc::EbfDiffusionAbc::stabilize with this map.
        * Throws ParameterError if the explicit step is unstable, or (absorbing,
@@ -130,6 +145,12 @@ namespace PeriDEAL
       {
         return abc;
       }
+      /** Imposed = half derivative: the boundary DoFs' history (EbfParameters::half_derivative_history). */
+      const Abc::HalfDerivativeHistory &
+      half_derivative_history() const
+      {
+        return half_history;
+      }
       /**
        * Spectral radius of the one-step map C^n -> C^{n+1} (ABC included),
        * by a dense eigenvalue problem (serial, at most @p max_size DoFs);
@@ -171,7 +192,7 @@ namespace PeriDEAL
        */
       double
       power_iterate(const unsigned int n_steps);
-      /** Imposed = half derivative: append C^n of the boundary DoFs to the history; boundary_values = its part of the half derivative at t^{n+1}. */
+      /** Imposed = half derivative: append C^n of the boundary DoFs to the history; boundary_values = its part sum_{j >= 1} g_j C^{n+1-j} of the half derivative at t^{n+1}. */
       void
       half_derivative_flux();
       /** C = the pseudo-random start on the owned cloud DoFs (seeded by global id), normalized. */
@@ -209,16 +230,15 @@ namespace PeriDEAL
       /** Imposed = normal derivative: the absorbing DoFs keep their FEM rows and get the EBF flux. */
       bool                           flux_boundary = false;
       /**
-       * Imposed = half derivative: the boundary DoFs, the curvature sum, the
-       * boundary values of every past level (level-major), the number of
-       * levels and the Gruenwald-Letnikov weights.
+       * Imposed = half derivative: the boundary DoFs, their values at the
+       * current level and their Gruenwald-Letnikov history.
        */
       bool                           half_derivative = false;
       std::vector<unsigned int>      half_dofs;
+      std::vector<double>            half_values;
+      Abc::HalfDerivativeHistory     half_history;
       /** Imposed = half derivative: kappa per boundary DoF (given or estimated). */
       std::vector<double>            half_curvature;
-      std::vector<double>            half_history, gl_weights;
-      unsigned int                   n_history_levels = 0;
       SolverControl                  solver_control;
       std::unique_ptr<TrilinosWrappers::SolverDirect> solver;
       Abc::EbfDiffusionAbc<dim>      abc;
