@@ -7,6 +7,7 @@
 //   kw_hybrid_benchmark [--dx 0.25] [--m 8] [--end-time 87.5e-6] [--sigma 0.95]
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
 //                       [--chunk 16] [--half-stencil 0|1] [--grouped-test 0|1]
+//                       [--row-test 0|1]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -22,7 +23,10 @@
 // stencils (HybridMechanicsParameters::half_stencil, default off; the same
 // bonds, another summation order). --grouped-test 0 keeps the per-offset
 // masked kernel of the exact switching test (length_grouped_test, default
-// on; the same q bit for bit).
+// on; the same q bit for bit); --row-test 0 the grouped kernel's per-offset
+// loads instead of one load per stencil row (row_shared_test, default on;
+// the same q bit for bit). The keys kw_hybrid_state_hash_* are FNV-1a
+// hashes of the final displacement and damage bits of each run.
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
 // at y = +-25). The source uses dx = 0.25 mm, delta = 2 mm (m = 8) and
@@ -40,6 +44,7 @@
 #include "../../tests/hybrid_kw/kalthoff_winkler_case.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <ctime>
 #include <map>
@@ -70,6 +75,22 @@ namespace
     s.model().damage(phi);
     return std::vector<double>(phi.begin(), phi.begin() + s.discretization().n_owned());
   }
+
+  /** FNV-1a of the bits of the final displacement and damage (one rank). */
+  std::uint64_t
+  state_hash(const MechanicsSolver<2> &s, const std::vector<double> &damage)
+  {
+    std::uint64_t hash = 1469598103934665603ull;
+    const auto    add  = [&](const double *a, const std::size_t n) {
+      const auto *bytes = reinterpret_cast<const unsigned char *>(a);
+      for (std::size_t k = 0; k < n * sizeof(double); ++k)
+        hash = (hash ^ bytes[k]) * 1099511628211ull;
+    };
+    for (unsigned int d = 0; d < 2; ++d)
+      add(s.integrator().displacement[d].begin(), s.discretization().n_owned());
+    add(damage.data(), damage.size());
+    return hash;
+  }
 } // namespace
 
 
@@ -78,7 +99,8 @@ main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
-  int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1;
+  int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1,
+              row_test = -1;
   std::string dir = "kw-hybrid-benchmark", bound = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
@@ -101,6 +123,8 @@ main(int argc, char **argv)
         half_stencil = std::stoi(value);
       else if (key == "--grouped-test")
         grouped_test = std::stoi(value);
+      else if (key == "--row-test")
+        row_test = std::stoi(value);
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -126,6 +150,8 @@ main(int argc, char **argv)
     ph.hybrid.half_stencil = half_stencil != 0;
   if (grouped_test >= 0)
     ph.hybrid.length_grouped_test = grouped_test != 0;
+  if (row_test >= 0)
+    ph.hybrid.row_shared_test = row_test != 0;
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = cpu_seconds() - t0;
@@ -260,6 +286,9 @@ main(int argc, char **argv)
             << "\nkw_hybrid_broken_bonds_adaptive: " << hybrid.model().n_broken_bonds()
             << "\nkw_hybrid_cracked_nodes_unmatched: " << unmatched[0] + unmatched[1]
             << "\nkw_hybrid_speedup_median_chunk: " << median_ratio
+            << std::hex << std::setfill('0') << "\nkw_hybrid_state_hash_standard: " << std::setw(16)
+            << state_hash(standard, ds) << "\nkw_hybrid_state_hash_adaptive: " << std::setw(16)
+            << state_hash(hybrid, dh) << std::dec << std::setfill(' ')
             << "\nkw_speedup_hybrid_adaptive_over_standard: " << ts / th << std::endl;
   return 0;
 }

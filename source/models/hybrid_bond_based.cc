@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <sstream>
 
 #if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__)
@@ -331,6 +333,121 @@ namespace PeriDEAL
       else
         return _mm256_maskz_mov_pd(lanes, q);
     }
+
+    /** f(integral_constant<int, A>) for each A, in order. */
+    template <typename F, int... A>
+    inline void
+    for_each_column(const F &f, std::integer_sequence<int, A...>)
+    {
+      (f(std::integral_constant<int, A>()), ...);
+    }
+
+    /** Lanes r, ..., r + W - 1 of the concatenation (lo, hi) (valignq). */
+    template <int W, int r>
+    inline typename Lanes<W>::V
+    shifted(const typename Lanes<W>::V lo, const typename Lanes<W>::V hi)
+    {
+      if constexpr (r == 0)
+        return lo;
+      else if constexpr (W == 8)
+        return _mm512_castsi512_pd(
+          _mm512_alignr_epi64(_mm512_castpd_si512(hi), _mm512_castpd_si512(lo), r));
+      else
+        return _mm256_castsi256_pd(
+          _mm256_alignr_epi64(_mm256_castpd_si256(hi), _mm256_castpd_si256(lo), r));
+    }
+
+    /**
+     * max_ratio_grouped() in 2D (stencil radius <= 8) by stencil rows: per
+     * pair of rows +-b (box row stride @p row) the vectors at L +- b row +
+     * W j, |j| <= 8 / W, are loaded once per dimension, and each offset's
+     * lanes are shifted out of two of them (valignq) instead of two
+     * unaligned loads per offset (the kernel was bound by its loads). The
+     * up to four offsets (+-a, +-b) of one length share one multiplication
+     * by 1 / T^2 (row_iL2[9 b + a]; bit a of row_mask[b]: (a, b) is an
+     * offset). The same q bit for bit, for the reasons of
+     * max_ratio_grouped(); |y|^2 by the same expression.
+     */
+    template <int W>
+    inline typename Lanes<W>::V
+    max_ratio_rows(const double *p, const std::size_t N, const std::size_t L,
+                   const std::int64_t row, const std::uint16_t *row_mask,
+                   const double *row_iL2, const unsigned int n_rows, const __mmask8 lanes)
+    {
+      using S             = Lanes<W>;
+      using V             = typename S::V;
+      constexpr int J     = 8 / W;
+      const V       pi0   = S::load(p + L), pi1 = S::load(p + N + L);
+      const auto    l2_of = [&](const V y0, const V y1) {
+        const V a  = S::sub(y0, pi0);
+        V       l2 = S::mul(a, a);
+        const V b  = S::sub(y1, pi1);
+        return S::fmadd(b, b, l2);
+      };
+      V q0 = S::set1(0.), q1 = q0;
+      // One stencil row pair (both rows if two): v[s][d][j + J] is
+      // dimension d of the vector at L + (s ? -b : b) row + W j.
+      const auto rows = [&](const unsigned int b, const unsigned int mask, const auto two) {
+        constexpr unsigned int ns = decltype(two)::value ? 2 : 1;
+        V                      v[ns][2][2 * J + 1];
+        const bool             side = mask > 1u;
+        for (unsigned int s = 0; s < ns; ++s)
+          for (unsigned int d = 0; d < 2; ++d)
+            {
+              const double *base = p + d * N + L + (s ? -std::int64_t(b) : std::int64_t(b)) * row;
+              for (int j = -J; j <= J; ++j)
+                v[s][d][j + J] = j == 0 || side ? S::load(base + W * j) : S::set1(0.);
+            }
+        const double *iL2 = row_iL2 + 9 * b;
+        // Offset x-component a (compile time): its lanes in row s.
+        const auto at = [&](const unsigned int s, const auto A) {
+          constexpr int a = decltype(A)::value;
+          constexpr int j = a >= 0 ? a / W : -((-a + W - 1) / W);
+          constexpr int r = a - W * j;
+          V             y[2];
+          for (unsigned int d = 0; d < 2; ++d)
+            {
+              if constexpr (r == 0)
+                y[d] = v[s][d][j + J];
+              else
+                y[d] = shifted<W, r>(v[s][d][j + J], v[s][d][j + J + 1]);
+            }
+          return l2_of(y[0], y[1]);
+        };
+        const auto column = [&](const auto A) {
+          constexpr int a = decltype(A)::value;
+          if (((mask >> a) & 1u) == 0)
+            return;
+          V m = at(0, std::integral_constant<int, a>());
+          if constexpr (a > 0)
+            m = S::max(m, at(0, std::integral_constant<int, -a>()));
+          if constexpr (ns == 2)
+            {
+              m = S::max(m, at(1, std::integral_constant<int, a>()));
+              if constexpr (a > 0)
+                m = S::max(m, at(1, std::integral_constant<int, -a>()));
+            }
+          const V x = S::mul(m, S::set1(iL2[a]));
+          if constexpr (a % 2 == 0)
+            q0 = S::max(q0, x);
+          else
+            q1 = S::max(q1, x);
+        };
+        for_each_column(column, std::make_integer_sequence<int, 9>());
+      };
+      if (row_mask[0] != 0)
+        rows(0, row_mask[0], std::false_type());
+      for (unsigned int b = 1; b < n_rows; ++b)
+        if (row_mask[b] != 0)
+          rows(b, row_mask[b], std::true_type());
+      // max(q0, q1) in the lanes kept, 0 elsewhere (the zero-masked form:
+      // GCC 12 warns falsely about the unmasked intrinsic's undefined
+      // pass-through operand here).
+      if constexpr (S::wide)
+        return _mm512_maskz_max_pd(lanes, q0, q1);
+      else
+        return _mm256_maskz_max_pd(lanes, q0, q1);
+    }
 #endif
   } // namespace
 
@@ -637,7 +754,9 @@ namespace PeriDEAL
       reach = std::max(reach, std::abs(o));
     for (const auto o : shared_offset)
       reach = std::max(reach, std::abs(o));
-    sweep_pad       = 8 * std::size_t((reach + 7) / 8);
+    // One vector more than the reach: the row-shared exact test
+    // (max_ratio_rows()) loads whole vectors around a stencil row.
+    sweep_pad       = 8 * std::size_t((reach + 8 + 7) / 8);
     sweep_n_vectors = (n_box + 7) / 8;
     sweep_n_alloc   = 2 * sweep_pad + 8 * sweep_n_vectors + 8;
     internal::LatticeSweep::map_box_positions<dim>(
@@ -711,6 +830,7 @@ namespace PeriDEAL
       all_offsets[f] = f;
     lattice_bound_on = false;
     grouped_on       = false;
+    rows_on          = false;
     if constexpr (dim == 2)
       if (prm.switching_bound && prm.lattice_bound && std::isfinite(s0))
         {
@@ -789,6 +909,32 @@ namespace PeriDEAL
               grouped_offset.push_back(sweep_offset[f]);
             }
           group_start.push_back(grouped_offset.size());
+          // The stencil by rows for max_ratio_rows(): every offset (a, b)
+          // with |a|, |b| <= 8, and per (|a|, |b|) all its sign variants
+          // with one 1 / T^2 (else the grouped kernel stays).
+          rows_on = false;
+          if (grouped_on && prm.row_shared_test && box_radius <= 8)
+            {
+              const int          W      = 2 * box_radius + 1;
+              const unsigned int n_rows = box_radius + 1;
+              std::vector<unsigned int> count(9 * n_rows, 0);
+              row_mask.assign(n_rows, 0);
+              row_iL2.assign(9 * n_rows, 0.);
+              bool ok = true;
+              for (unsigned int f = 0; f < sweep_offset.size(); ++f)
+                {
+                  const int a = int(sweep_box[f] % W) - box_radius,
+                            b = int(sweep_box[f] / W % W) - box_radius;
+                  const unsigned int c = 9 * std::abs(b) + std::abs(a);
+                  if (count[c]++ == 0)
+                    row_iL2[c] = sweep_iL2[f];
+                  ok = ok && row_iL2[c] == sweep_iL2[f] && sweep_offset[f] == a + b * row;
+                  row_mask[std::abs(b)] |= std::uint16_t(1u << std::abs(a));
+                }
+              for (unsigned int c = 0; c < count.size(); ++c)
+                ok = ok && (count[c] == 0 || count[c] == (c % 9 > 0 ? 2u : 1u) * (c / 9 > 0 ? 2u : 1u));
+              rows_on = ok && (row_mask[0] & 1u) == 0;
+            }
         }
 #endif
   }
@@ -1262,17 +1408,23 @@ namespace PeriDEAL
             // only after the end switched): the grouped kernel, no masks.
             const unsigned full = full_lanes[v];
             const bool grouped = lip && grouped_on && (full & tl) == tl;
+            const bool by_rows = grouped && rows_on;
             __m512d    qmax;
             if (half)
               {
                 const __mmask8 m4 = __mmask8(tl >> (4 * h));
                 const __m256d  q4 =
+                  by_rows ? max_ratio_rows<4>(p, N, L0 + 4 * h, sweep_stride[1], row_mask.data(),
+                                              row_iL2.data(), row_mask.size(), m4) :
                   grouped ? max_ratio_grouped<dim, 4>(p, N, L0 + 4 * h, grouped_offset.data(), group_start.data(),
                                                       group_iL2.data(), group_iL2.size(), m4) :
                             max_ratio<dim, 4, true>(p, N, L0 + 4 * h, offset, iL2, bits, 4 * h, m4, nullptr,
                                                     group.size());
                 qmax = h ? _mm512_insertf64x4(_mm512_setzero_pd(), q4, 1) : _mm512_zextpd256_pd512(q4);
               }
+            else if (by_rows)
+              qmax = max_ratio_rows<8>(p, N, L0, sweep_stride[1], row_mask.data(), row_iL2.data(),
+                                       row_mask.size(), tl);
             else if (grouped)
               qmax = max_ratio_grouped<dim, 8>(p, N, L0, grouped_offset.data(), group_start.data(),
                                                group_iL2.data(), group_iL2.size(), tl);

@@ -19,6 +19,8 @@
 //             at every step (KW at CI size, 1 or 2 ranks);
 //  grouped_test: the exact test's kernel grouped by bond length = the
 //             per-offset masked kernel (the same exact node tests too);
+//  row_test:  the same with the grouped kernel's loads shared along the
+//             stencil rows (row_shared_test);
 //  half_stencil: the half-stencil Omega_s sweep = the full-stencil rows
 //             (broken bonds, switching, damage; forces to round-off);
 //  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
@@ -817,24 +819,60 @@ namespace
     check(tests_fast < 0.25 * tests_every, "most exact node tests skipped");
   }
 
+  // A variant @p kernel of the exact test's kernel against the per-offset
+  // masked kernel, on KW at CI size on 1 or 2 ranks: both compute q = max
+  // |y|^2 / T^2 bit for bit, so the slack of every node, hence the exact
+  // node tests (not only the outcome), must be the same, as must the
+  // switches, damage and displacements. A q that is too small would skip
+  // needed tests (the switch evaluations differ, see kw_equivalence), a q
+  // that is too large adds exact tests.
+  void
+  check_same_as_masked(const std::function<void(HybridMechanicsParameters &)> &kernel,
+                       const std::string &dir)
+  {
+    const auto [tests_kernel, tests_masked] = check_kw_same(
+      kernel, [](HybridMechanicsParameters &h) { h.length_grouped_test = false; },
+      "the per-offset masked kernel", dir);
+    check(tests_kernel == tests_masked && tests_kernel > 0,
+          "the same exact node tests: " + std::to_string(tests_kernel) + " / " +
+            std::to_string(tests_masked));
+  }
+
+  // The grouped kernel, with loads shared along the stencil rows or not.
+  std::function<void(HybridMechanicsParameters &)>
+  grouped_kernel(const bool by_rows)
+  {
+    return [by_rows](HybridMechanicsParameters &h) {
+      h.length_grouped_test = true;
+      h.row_shared_test     = by_rows;
+    };
+  }
+
   // (h2) The exact test's kernel grouped by bond length (no lane masks,
-  // length_grouped_test, the default) against the per-offset masked
-  // kernel, on KW at CI size on 1 or 2 ranks: both compute q = max |y|^2 /
-  // T^2 bit for bit, so the slack of every node, hence the exact node tests
-  // (not only the outcome), must be the same, as must the switches, damage
-  // and displacements. A q that is too small would skip needed tests (the
-  // switch evaluations differ, see kw_equivalence), a q that is too large
-  // adds exact tests.
+  // length_grouped_test) with a load per offset.
   void
   grouped_test()
   {
-    const auto [tests_grouped, tests_masked] = check_kw_same(
-      [](HybridMechanicsParameters &h) { h.length_grouped_test = true; },
-      [](HybridMechanicsParameters &h) { h.length_grouped_test = false; },
-      "the per-offset masked kernel", "kw-grouped-test");
-    check(tests_grouped == tests_masked && tests_grouped > 0,
-          "the same exact node tests: " + std::to_string(tests_grouped) + " / " +
-            std::to_string(tests_masked));
+    check_same_as_masked(grouped_kernel(false), "kw-grouped-test");
+  }
+
+  // (h3) The grouped kernel with one load per stencil row and dimension
+  // (row_shared_test, the default: offsets shifted out of the row's
+  // vectors), at CI size with the stencil of radius 4.
+  void
+  row_test()
+  {
+    check_same_as_masked(grouped_kernel(true), "kw-row-test");
+    // The path under test is taken (AVX-512 lattice sweeps only; else
+    // neither kernel exists).
+    MechanicsSolver<2> s(MPI_COMM_WORLD,
+                         kalthoff_winkler(1., 4., 87.5e-6, "hybrid adaptive", 0.8, "kw-row-test-setup"));
+    s.setup();
+    const auto *hm = s.hybrid_model();
+    check(hm->uses_row_shared_test() == hm->uses_lattice_sweep(),
+          std::string("the row-shared kernel is used: ") +
+            (hm->uses_row_shared_test() ? "yes" : "no") + " (lattice sweep: " +
+            (hm->uses_lattice_sweep() ? "yes" : "no") + ")");
   }
 
   // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
@@ -880,6 +918,7 @@ main(int argc, char **argv)
               {"kw_lattice", kw_lattice},
               {"kw_equivalence", kw_equivalence},
               {"grouped_test", grouped_test},
+              {"row_test", row_test},
               {"half_stencil", half_stencil},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

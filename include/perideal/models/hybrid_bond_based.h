@@ -68,6 +68,15 @@ namespace PeriDEAL
      * (the reference of test hybrid_kw.grouped_test).
      */
     bool length_grouped_test = true;
+    /**
+     * With length_grouped_test (2D, stencil radius <= 8): the grouped
+     * kernel loads the positions of each stencil row once (three vectors
+     * per row and dimension) and shifts every offset's lanes out of them
+     * (valignq) instead of two unaligned loads per offset; the four offsets
+     * (+-a, +-b) of one length share one multiplication. The same q bit for
+     * bit; false keeps the per-offset loads of the grouped kernel.
+     */
+    bool row_shared_test = true;
   };
 
   /**
@@ -320,6 +329,16 @@ namespace PeriDEAL
     uses_lattice_sweep() const
     {
       return sweep_on;
+    }
+    /**
+     * Whether the exact switching test's grouped kernel loads the stencil
+     * rows once (HybridMechanicsParameters::row_shared_test, and a 2D
+     * stencil of radius <= 8 with the lattice bound).
+     */
+    bool
+    uses_row_shared_test() const
+    {
+      return rows_on;
     }
     /**
      * Number of owned Omega_w rows that use the shared WLS weights of the
@@ -620,6 +639,14 @@ namespace PeriDEAL
     std::vector<std::uint32_t> group_start;
     std::vector<double>        group_iL2;
     bool                       grouped_on = false;
+    /**
+     * The stencil by rows (row_shared_test): per row b in [0, R], bit a of
+     * row_mask[b] says (a, b) (hence (+-a, +-b)) is an offset;
+     * row_iL2[9 b + a] its 1 / T^2; on.
+     */
+    std::vector<std::uint16_t> row_mask;
+    std::vector<double>        row_iL2;
+    bool                       rows_on = false;
     bool                       lip_have_prev = false, lip_swap_pending = false;
     /** @} */
     unsigned int        n_evaluations = 0;
