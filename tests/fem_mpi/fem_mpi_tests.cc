@@ -308,11 +308,11 @@ namespace
    * the same disk with Neumann truncation as the baseline.
    */
   /**
-   * Energy errors (max over the run, at t_end; Neumann at t_end) and the
+   * Energy errors (max over the run, at t_end; Neumann at t_end), the
    * max pointwise error at t_end of the disk run of disk_diffusion() with
-   * @p ap (d_inf = 0.2 set here).
+   * @p ap (d_inf = 0.2 set here) and the Delta k used.
    */
-  std::array<double, 4>
+  std::array<double, 5>
   run_disk_diffusion(Abc::EbfParameters ap)
   {
     const double       R = 3., t_end = 3.;
@@ -360,7 +360,7 @@ namespace
       std::cout << "  disk R = 3, t = 3: |Pi - Pi_exact|/Pi0 EBF max " << sci(max_ebf) << " end " << sci(end_ebf)
                 << ", Neumann end " << sci(end_neumann) << " (ratio " << end_neumann / end_ebf
                 << "); max |C - heat kernel| EBF " << sci(err_ebf) << " Neumann " << sci(err_neumann) << std::endl;
-    return {{max_ebf, end_ebf, end_neumann, err_ebf}};
+    return {{max_ebf, end_ebf, end_neumann, err_ebf, st.wave_number_range}};
   }
 
   /**
@@ -493,22 +493,25 @@ namespace
     // Session 13: the sink fit (V_j >= 0, sum_j V_j <= 1) of the value
     // form. Its sink follows the mode range, as the normal derivative's q
     // did: end ratio vs Neumann with the curved modes (rho = R, 2D WKB
-    // amplitude sqrt(R/r)) at Delta k 3 / 5 / 7 / 10 (the default 2/d_inf):
-    // 31x / 20x / 9.9x / 7.1x; plane modes at Delta k 5 / 10: 56x / 7.8x.
-    // The pulse is wide at the boundary here (decay rate 8 r/s = 0.49 at
-    // t_end), so the default range over-absorbs. On the disk the curved
-    // modes lose against the plane ones (the 2D radial mode is K_0, not the
-    // WKB form); on the ball they gain (design.md, session 13). Asserted at
-    // Delta k 5: the curved and the plane sink fit; tolerances ~50 % above
-    // the measured errors, the ratio is the issue's 10x.
+    // amplitude sqrt(R/r)) at Delta k 3 / 5 / 7 / 10: 31x / 20x / 9.9x /
+    // 7.1x; plane modes at Delta k 5 / 10: 56x / 7.8x. The pulse is wide
+    // at the boundary here (decay rate 8 r/s = 0.49 at t_end), so the range
+    // 2/d_inf over-absorbs. Session 14: the sink fit's default Delta k is
+    // 1/d_inf (= 5 here: D Delta k^2 = D/d_inf^2, no mode faster than
+    // diffusion across the cloud), chosen on this case and verified on the
+    // ball, the cube and disks of other R, t_end, d_inf (design.md,
+    // session 14). Asserted with the default: the range 1/d_inf is used,
+    // and the curved and the plane sink fit reach the issue's 10x (the old
+    // default 2/d_inf fails this: 7.1x / 7.8x); tolerances of the max over
+    // the run ~50 % above the measured 1.95e-3 / 1.68e-3.
     for (const double rho : {3., 0.})
       {
         Abc::EbfParameters sink;
         sink.fit               = "sink";
-        sink.wave_number_range = 5.;
         sink.curvature_radius  = rho;
         const auto f           = run_disk_diffusion(sink);
         const std::string name = rho > 0. ? "disk, sink fit, curved modes" : "disk, sink fit, plane modes";
+        check(std::abs(f[4] - 1. / 0.2) < 1e-12, name + ": default Delta k " + std::to_string(f[4]) + " = 1/d_inf");
         check(f[2] >= 10. * f[1] && f[0] < (rho > 0. ? 3e-3 : 2.5e-3),
               name + ": at least 10x closer than Neumann at t_end (" + std::to_string(f[2] / f[1]) +
                 "x), max |Pi - Pi_exact|/Pi0 = " + sci(f[0]));
@@ -1031,8 +1034,12 @@ namespace
     // max |C - heat kernel| 2.9e-3, Pi lower after every step, growth
     // 0.99688 (power iteration) / 0.99877 (Arnoldi); curvature radius 1.2 /
     // 2 / 3: 32x / 22x / 19x; d_inf 0.6 96x, Delta k 8 23x, dt 5e-4 26x;
-    // refinement 4 (d_inf 0.3) 25x. Tolerance ~50 % above the measured
-    // error; the ratio is the issue's 10x.
+    // refinement 4 (d_inf 0.3) 25x (all at Delta k 2/d_inf = 4.44).
+    // Session 14: the sink fit's default Delta k is 1/d_inf = 2.22:
+    // sum_j V_j 0.99851 .. 0.99870, end 1.61e-3 (72x), max over the run
+    // 4.20e-3 (mid-run; 4.43e-3 before), growth 0.99712 / 0.99882. The
+    // tolerance on the max stays ~50 % above the session-13 value; the
+    // ratio is the issue's 10x.
     const auto ball_sink = diffusion_3d(true, 1.5, 3, 0.5, 1e-3, 0.45, "sink", "value",
                                         [](Abc::EbfParameters &ap) { ap.curvature_radius = 1.5; });
     check(ball_sink[2] >= 10. * ball_sink[1] && ball_sink[0] < 6.6e-3,
@@ -1073,7 +1080,8 @@ namespace
    * Exploratory scan (not a ctest case): FEMBALL_SCAN="key=value;..." with
    * shape (ball|cube|disk), fit, form, rcond, dinf, dk, nk, nphi, dt,
    * imposed, ref, t, checksteps, kappa, distributed, rho, history (of the
-   * half derivative: exact or sum of exponentials); prints the energy
+   * half derivative: exact or sum of exponentials), R (disk radius, 3);
+   * dk = 0 is the library's default Delta k; prints the energy
    * errors and the one-step spectral radius.
    */
   void
@@ -1084,7 +1092,7 @@ namespace
                                           {"rcond", "0"}, {"dinf", "0.45"}, {"dk", "0"}, {"nk", "20"},
                                           {"nphi", "5"}, {"dt", "1e-3"}, {"imposed", "value"}, {"ref", "3"},
                                           {"t", "0.5"}, {"checksteps", "200"}, {"kappa", "0"}, {"distributed", "0"},
-                                          {"rho", "0"}, {"history", "sum of exponentials"}};
+                                          {"rho", "0"}, {"history", "sum of exponentials"}, {"R", "3"}};
     std::string spec = env ? env : "";
     for (std::size_t pos = 0; pos < spec.size();)
       {
@@ -1115,7 +1123,7 @@ namespace
       {
         if (kv["shape"] == "disk")
           {
-            const double                R = 3., t_end = std::stod(kv["t"]);
+            const double                R = std::stod(kv["R"]), t_end = std::stod(kv["t"]);
             Fem::FemDiffusionParameters fp;
             fp.time_step = std::stod(kv["dt"]);
             Abc::EbfParameters ap;
@@ -1150,7 +1158,8 @@ namespace
             if (root())
               std::cout << "  disk: EBF end " << sci(end_e) << " max " << sci(max_e) << ", Neumann end " << sci(end_n)
                         << " (ratio " << end_n / end_e << "), Arnoldi " << arnoldi << ", max|V| "
-                        << sci(ebf.absorbing_boundary().statistics().max_update_norm) << std::endl;
+                        << sci(ebf.absorbing_boundary().statistics().max_update_norm) << ", Delta k "
+                        << ebf.absorbing_boundary().statistics().wave_number_range << std::endl;
           }
         else
           {

@@ -35,7 +35,12 @@ namespace PeriDEAL
       /** n_phi: directions phi_l equally spaced in [0, pi/2] (2D), or per
        * spherical angle (3D). Ignored in 1D. */
       unsigned int n_directions = 5;
-      /** Delta k of (4.25); 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D (empirical, see the .cc). */
+      /**
+       * Delta k of (4.25); 0 selects 1/(8 d_inf) in 1D, 2/d_inf in 2D/3D
+       * (empirical, see the .cc), and 1/d_inf with the sink fit in 2D/3D
+       * (D Delta k^2 = D/d_inf^2: no mode faster than diffusion across the
+       * cloud).
+       */
       double wave_number_range = 0.;
       /** Cloud radius d_inf. */
       double cloud_radius = 0.25;
