@@ -716,7 +716,9 @@ namespace
   // Exploratory (not registered): E13_SCAN="key=value ...; ..." runs of E13
   // (e13_default) with the EBF keys of with_wave_settings, plus L, T, dt,
   // newmark=1, rho=1 (one-step spectral radius on (-3, 3)^2, h = 0.5) or
-  // rhoonly=1.
+  // rhoonly=1, where=n (the n largest field errors at t_end and the max
+  // error per ring along the boundary) and lref (half width of the extended
+  // reference).
   void
   e13_scan()
   {
