@@ -19,3 +19,7 @@ perideal_add_test(NAME fem_abc.verlet_layer_spectral_radius COMMAND $<TARGET_FIL
 perideal_add_test(NAME fem_abc.verlet_energy_decay COMMAND $<TARGET_FILE:fem_abc_tests> verlet_energy_decay_short LABELS unit)
 perideal_add_test(NAME fem_abc.verlet_energy_decay_long COMMAND $<TARGET_FILE:fem_abc_tests> verlet_energy_decay_long LABELS long TIMEOUT 3000)
 perideal_add_test(NAME fem_abc.e13_verlet_layer COMMAND $<TARGET_FILE:fem_abc_tests> e13_verlet_layer LABELS convergence)
+# Session 14: curved modes (rho 64) with Newmark + consistent mass, the
+# long-run-stable route: radius and energy decay (unit), E13 ratios (~40 s).
+perideal_add_test(NAME fem_abc.newmark_curved_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_curved_stability LABELS unit)
+perideal_add_test(NAME fem_abc.newmark_e13_curved COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_curved LABELS "convergence;long" TIMEOUT 1200)
