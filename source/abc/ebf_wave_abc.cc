@@ -1559,6 +1559,7 @@ namespace PeriDEAL
       double peak = 0.;
       for (unsigned int i = 0; i < n; ++i)
         {
+          r.eigenvector_u.push_back(x[i]);
           r.mode_u[i] = std::abs(x[i]);
           r.mode_v[i] = std::abs(x[n + i]);
           peak        = std::max({peak, r.mode_u[i], r.mode_v[i]});
@@ -1566,6 +1567,7 @@ namespace PeriDEAL
       for (unsigned int i = 0; i < n; ++i)
         {
           r.mode_u[i] /= peak;
+          r.eigenvector_u[i] /= peak;
           r.mode_v[i] /= peak;
         }
       const auto &nodes = abc.absorbing_points();

@@ -833,12 +833,49 @@ namespace
       }
   }
 
+  /**
+   * Phase pattern of a nodal field @p u on the layer (depth < delta) of the
+   * disc @p R centred at the origin: the correlation sum w Re(u_i conj(u_j))
+   * / sum w (|u_i|^2 + |u_j|^2)/2 over the pairs within sqrt(2) dx, weighted
+   * tangentially ((1 - (n.e)^2)^2) or normally ((n.e)^2): +1 smooth, -1 a
+   * sawtooth (the Verlet FEM layer's unstable mode, session 13). Returns
+   * {tangential, normal}.
+   */
+  std::array<double, 2>
+  layer_correlation(const std::vector<Point<2>> &x, const std::vector<std::complex<double>> &u, const double R,
+                    const LatticeParameters &lp)
+  {
+    double ct = 0., nt = 0., cn = 0., nn = 0.;
+    std::vector<unsigned int> layer;
+    for (unsigned int i = 0; i < u.size(); ++i)
+      if (R - x[i].norm() < lp.delta)
+        layer.push_back(i);
+    for (unsigned int a = 0; a < layer.size(); ++a)
+      for (unsigned int b = a + 1; b < layer.size(); ++b)
+        {
+          const unsigned int i = layer[a], j = layer[b];
+          const Tensor<1, 2> e = x[j] - x[i];
+          if (e.norm() > std::sqrt(2.) * lp.dx * (1. + 1e-6))
+            continue;
+          const Tensor<1, 2> n  = (x[i] + x[j]) / (x[i] + x[j]).norm();
+          const double       c2 = std::pow(n * e / e.norm(), 2);
+          const double       re = std::real(u[i] * std::conj(u[j]));
+          const double       sq = 0.5 * (std::norm(u[i]) + std::norm(u[j]));
+          ct += std::pow(1. - c2, 2) * re;
+          nt += std::pow(1. - c2, 2) * sq;
+          cn += c2 * re;
+          nn += c2 * sq;
+        }
+    return {{ct / nt, cn / nn}};
+  }
+
   /** Spectral radius of the one-step map of a small 2D PD disc (E14 parameters). */
   double
   radius_2d(const double R, const WaveAbcParameters &prm, const double dx = 0.25,
             const double m = 6, unsigned int *n_up = nullptr, WaveCloudStatistics *stats = nullptr,
             std::complex<double> *dominant = nullptr, WaveSpectralDiagnostics *diag = nullptr,
-            const WaveTruncation boundary = WaveTruncation::absorbing, const double dt = 0.02)
+            const WaveTruncation boundary = WaveTruncation::absorbing, const double dt = 0.02,
+            std::vector<Point<2>> *positions = nullptr)
   {
     LatticeParameters lp;
     lp.dx    = dx;
@@ -853,6 +890,8 @@ namespace
     pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, boundary, prm, zero);
     if (stats)
       *stats = pd.absorbing_boundary().statistics();
+    if (positions)
+      *positions = pd.discretization().position;
     if (diag)
       {
         *diag = pd.spectral_diagnostics(20000);
@@ -1211,11 +1250,30 @@ namespace
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
     std::complex<double> dom2;
-    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2);
+    WaveSpectralDiagnostics diag2;
+    std::vector<Point<2>>   x2;
+    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2, &diag2, WaveTruncation::absorbing, 0.02, &x2);
     std::cout << "    2D R = 2.5, cone 0.5: rho - 1 = " << sci(rho2 - 1.) << " (" << n_up << " eigenvalues > 1 + 1e-8), cond "
               << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     check(st.max_condition_number <= 1e12 && st.max_update_norm <= 2. && rho2 > 1. + 1e-4,
           "2D: local guards hold but rho > 1 + 1e-4 (known, doc/design.md)");
+    // Not the Verlet FEM layer's instability (a tangential sawtooth,
+    // correlation -1, removed by a tangential viscosity; session 13): the
+    // growing mode's u in the layer is uncorrelated tangentially (measured
+    // +0.03, normal -0.15), and tangential layer filters do not stabilize
+    // it (doc/design.md, session 14).
+    {
+      LatticeParameters l2;
+      l2.dx          = 0.25;
+      l2.delta       = 6 * l2.dx;
+      const auto cor = layer_correlation(x2, diag2.eigenvector_u, 2.5, l2);
+      std::cout << "    2D dominant mode, layer correlation of u: tangential " << cor[0] << ", normal " << cor[1] << std::endl;
+      double dev = 0.;
+      for (unsigned int i = 0; i < x2.size(); ++i)
+        dev = std::max(dev, std::abs(std::abs(diag2.eigenvector_u[i]) - diag2.mode_u[i]));
+      check(x2.size() == diag2.eigenvector_u.size() && dev < 1e-12, "eigenvector_u: one entry per node, modulus mode_u");
+      check(cor[0] > -0.5 && cor[1] > -0.5, "2D: the growing mode is not a sawtooth along or across the layer");
+    }
     // Where the 2D instability sits: its frequency arg(lambda)/dt is the top
     // of the discrete PD spectrum, max_k sqrt(Omega^2(k) - d^2) over the
     // Brillouin zone |k_i| <= pi/dx (the plateau of short waves with ~zero
@@ -1941,6 +1999,9 @@ namespace
                             if (Rd - x[i].norm() < lp.delta)
                               angle_max[ab] = std::max(angle_max[ab], m);
                           }
+                        const auto cor = layer_correlation(x, diag.eigenvector_u, Rd, lp);
+                        std::cout << "      layer correlation of u: tangential " << cor[0] << ", normal " << cor[1]
+                                  << std::endl;
                         std::cout << "      max |u| by depth (dx):";
                         for (const auto &e : depth_max)
                           std::cout << " " << e.first << ":" << sci(e.second);
@@ -1978,6 +2039,16 @@ namespace
                 std::cout << " | per-step growth of sqrt(E) over the last tenth "
                           << sci(std::pow(e[10] / e[9], 0.5 / (n / 10)) - 1.) << " (" << sci(timer.cpu_time()) << " s)"
                           << std::endl;
+                // The pattern of the state after the power iteration.
+                const auto &xl = pd.discretization().position;
+                std::vector<std::complex<double>> ul(pd.discretization().n_owned());
+                for (unsigned int i = 0; i < ul.size(); ++i)
+                  ul[i] = pd.displacement().local_element(i);
+                const auto cor = layer_correlation(xl, ul, Rl, lp);
+                // The half-step energy includes the layer nodes' v^{n+1/2},
+                // which advance() computes from a stale acceleration.
+                std::cout << "      layer correlation of u: tangential " << cor[0] << ", normal " << cor[1]
+                          << "; E^{n+1/2}/E0 " << sci(pd.half_step_energy() / e[0]) << std::endl;
               }
             catch (const std::exception &ex)
               {

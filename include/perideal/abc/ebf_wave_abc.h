@@ -293,6 +293,8 @@ namespace PeriDEAL
       std::complex<double> dominant;
       /** |u| and |v| of the dominant eigenvector per owned node (max of both = 1). */
       std::vector<double> mode_u, mode_v;
+      /** The u part of the dominant eigenvector per owned node (same scaling): its phase pattern. */
+      std::vector<std::complex<double>> eigenvector_u;
       /** Share of the squared dominant eigenvector on the absorbing nodes (u, v, old levels). */
       double layer_fraction = 0.;
       /** Share of the squared dominant eigenvector in the v entries of the absorbing nodes. */
