@@ -65,6 +65,14 @@ namespace PeriDEAL
        */
       double pseudo_inverse_tolerance = 0.;
       /**
+       * How the pseudo-inverse treats the small singular values: "truncate"
+       * (LAPACK's rcond: 1/sigma for sigma > tol sigma_max, else 0) or
+       * "tikhonov" (sigma/(sigma^2 + lambda^2) with lambda = tol sigma_max
+       * for every sigma above the default rank threshold): a continuous
+       * family between two truncation ranks.
+       */
+      std::string pseudo_inverse_regularization = "truncate";
+      /**
        * PD, serial runs: if the state size 2 n_nodes + 2 n_cloud_points is at
        * most this, setup computes the spectral radius of the one-step map
        * (PdUnboundedWave::one_step_spectral_radius) and throws
