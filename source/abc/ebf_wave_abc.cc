@@ -71,6 +71,9 @@ namespace PeriDEAL
                         "Guard on max_j |V_j| (Sect. 4.2.3).");
       prm.declare_entry("Pseudo-inverse tolerance", "0", Patterns::Double(0., 1.),
                         "Relative singular-value cutoff of M^+ (0: max(rows, cols) * machine epsilon).");
+      prm.declare_entry("Pseudo-inverse regularization", "truncate", Patterns::Selection("truncate|tikhonov"),
+                        "truncate (1/sigma above the tolerance, 0 below) or tikhonov (sigma/(sigma^2 + "
+                        "lambda^2), lambda = tolerance * sigma_max; needs a tolerance > 0).");
       prm.declare_entry("Time levels", "2", Patterns::Integer(1, 2),
                         "Levels of the cloud data in (4.79): 2 (n and n-1, the source) or 1 (n only).");
       prm.declare_entry("Spectral radius check size", "0", Patterns::Integer(0),
@@ -138,6 +141,7 @@ namespace PeriDEAL
       max_condition_number = prm.get_double("Maximum condition number");
       max_update_norm      = prm.get_double("Maximum updating vector norm");
       pseudo_inverse_tolerance = prm.get_double("Pseudo-inverse tolerance");
+      pseudo_inverse_regularization = prm.get("Pseudo-inverse regularization");
       spectral_check_size      = prm.get_integer("Spectral radius check size");
       n_time_levels            = prm.get_integer("Time levels");
       max_spectral_radius      = prm.get_double("Maximum spectral radius");
@@ -308,7 +312,7 @@ namespace PeriDEAL
       };
 
       Fit
-      fit(const CMatrix &M, const CRow &psi, const double tolerance)
+      fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false)
       {
         // One SVD gives both the Moore-Penrose inverse and the condition
         // number. Without a tolerance, Eigen's default rank threshold
@@ -319,16 +323,21 @@ namespace PeriDEAL
         const double                  tol = tolerance > 0. ? tolerance :
                                                              std::max(M.rows(), M.cols()) *
                                                                std::numeric_limits<double>::epsilon();
+        const double cut = tikhonov ? std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon() : tol;
         Eigen::Index rank = 0;
-        while (rank < sv.size() && sv[rank] > tol * sv[0])
+        while (rank < sv.size() && sv[rank] > cut * sv[0])
           ++rank;
-        const CRow Vc = ((psi * svd.matrixV().leftCols(rank)) *
-                         sv.head(rank).cwiseInverse().asDiagonal()) *
+        Eigen::VectorXd inverse = sv.head(rank).cwiseInverse();
+        if (tikhonov)
+          for (Eigen::Index q = 0; q < rank; ++q)
+            inverse[q] = sv[q] / (sv[q] * sv[q] + tol * tol * sv[0] * sv[0]);
+        const CRow Vc = ((psi * svd.matrixV().leftCols(rank)) * inverse.asDiagonal()) *
                         svd.matrixU().leftCols(rank).adjoint();
         // Conjugate-closed mode sets and real data: V is real (the imaginary
         // part is round-off).
         f.V    = Vc.real();
-        f.cond = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
+        f.cond = rank > 0 ? sv[0] / (tikhonov ? std::max(sv[rank - 1], tol * sv[0]) : sv[rank - 1]) :
+                            std::numeric_limits<double>::infinity();
         f.vmax = Vc.cwiseAbs().maxCoeff();
         return f;
       }
@@ -685,8 +694,13 @@ namespace PeriDEAL
                         MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
                       }
                 }
-              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance);
-              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance);
+              check_parameter(prm.pseudo_inverse_regularization == "truncate" ||
+                                (prm.pseudo_inverse_regularization == "tikhonov" && prm.pseudo_inverse_tolerance > 0.),
+                              "Absorbing boundary/Pseudo-inverse regularization", prm.pseudo_inverse_regularization,
+                              "truncate, or tikhonov with a Pseudo-inverse tolerance > 0");
+              const bool tikhonov = prm.pseudo_inverse_regularization == "tikhonov";
+              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
+              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
               if (increment)
                 {
                   // + e_i: cloud[0] = x_i, row 0 = level n.
@@ -1559,6 +1573,7 @@ namespace PeriDEAL
       double peak = 0.;
       for (unsigned int i = 0; i < n; ++i)
         {
+          r.eigenvector_u.push_back(x[i]);
           r.mode_u[i] = std::abs(x[i]);
           r.mode_v[i] = std::abs(x[n + i]);
           peak        = std::max({peak, r.mode_u[i], r.mode_v[i]});
@@ -1566,6 +1581,7 @@ namespace PeriDEAL
       for (unsigned int i = 0; i < n; ++i)
         {
           r.mode_u[i] /= peak;
+          r.eigenvector_u[i] /= peak;
           r.mode_v[i] /= peak;
         }
       const auto &nodes = abc.absorbing_points();

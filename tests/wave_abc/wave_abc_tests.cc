@@ -73,6 +73,13 @@ namespace
   constexpr double STABLE_FIELD_RATIO  = 5.;
   constexpr double STABLE_ENERGY_RATIO = 5.;
   /**
+   * The same for the 3 dx clouds with a Tikhonov-regularized pseudo-inverse
+   * (e14_tikhonov_parameters(), session 14): the issue's 10x. Measured
+   * field 15.9 (2.12e-4 vs 3.36e-3), energy 33 (4.4e-4 vs 1.46e-2).
+   */
+  constexpr double TIKHONOV_FIELD_RATIO  = 10.;
+  constexpr double TIKHONOV_ENERGY_RATIO = 10.;
+  /**
    * Shared updating vectors (E14 disc R = 6, t = 2R): largest difference of
    * the fields (per max |u|) and energies (per E0) from those with each
    * node's own vectors. Measured 3.6e-10 and 2.1e-11.
@@ -509,6 +516,26 @@ namespace
     return prm;
   }
 
+  /**
+   * The session-14 layer: e14_stable_parameters() with the clouds of the
+   * points within 3 dx (0.75; 5-8 points instead of 2-4) and a
+   * Tikhonov-regularized pseudo-inverse, sigma/(sigma^2 + lambda^2) with
+   * lambda = 2e-4 sigma_max. Truncating at rcond 1e-4 or 2e-4 keeps a
+   * singular direction (sigma ~ 2.1e-4 sigma_max) that makes the small discs
+   * grow (R = 2.5: 1 + 2.5e-4), cutting it at 3e-4 costs 4x in accuracy;
+   * the Tikhonov weight halves it, which is stable and keeps most of the
+   * accuracy (doc/design.md, session 14).
+   */
+  WaveAbcParameters
+  e14_tikhonov_parameters(const double disc_radius)
+  {
+    WaveAbcParameters prm             = e14_stable_parameters(disc_radius);
+    prm.cloud_radius                  = 0.75;
+    prm.pseudo_inverse_tolerance      = 2e-4;
+    prm.pseudo_inverse_regularization = "tikhonov";
+    return prm;
+  }
+
   // E14 (reduced): 2D PD, p = 2, omega_0, chi^2 = 1, d = 0.0125, Delta k = 1,
   // delta = m dx with m = 6 (as in the source), on a disc of radius R
   // against the same code on a disc large enough that nothing reaches its
@@ -555,6 +582,8 @@ namespace
     const auto P   = simulate<2>(BallDomain<2>(Point<2>(), R + PML_WIDTH), lp, mp, WaveTruncation::absorbing, pml_parameters(2., PML_WIDTH, 2.), u0, T, n_samples, inner);
     // The long-run stable EBF layer (session 13).
     const auto C   = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_stable_parameters(R), u0, T, n_samples, inner);
+    // The 3 dx / Tikhonov layer (session 14).
+    const auto K   = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_tikhonov_parameters(R), u0, T, n_samples, inner);
     const double norm0 = sum_squares(ref.fields[0]);
     for (unsigned int s = 0; s <= n_samples; ++s)
       if (root())
@@ -628,6 +657,17 @@ namespace
     check(STABLE_ENERGY_RATIO * c_energy < o_energy,
           "stable EBF: energy error at t = 2R " + sci(c_energy) + " at least " + std::to_string(STABLE_ENERGY_RATIO) + "x below first-order " + sci(o_energy));
     check(max_energy_increase(C.total_energy) <= 0., "stable EBF: near-field energy non-increasing (samples every R/4)");
+    const double k_field  = field_difference(K.fields.back(), ref.fields.back(), lp.dx) / norm0;
+    const double k_energy = std::abs(K.energy.back() - ref.energy.back()) / ref.energy[0];
+    if (root())
+      std::cout << "    3 dx / Tikhonov EBF at t = 2R: field " << sci(k_field) << " (first-order / it " << o_field / k_field
+                << "), energy " << sci(k_energy) << " (ratio " << o_energy / k_energy << "), clouds " << K.stats.min_cloud_size
+                << ".." << K.stats.max_cloud_size << std::endl;
+    check(TIKHONOV_FIELD_RATIO * k_field < o_field && k_field < c_field,
+          "3 dx / Tikhonov EBF: field error at t = 2R " + sci(k_field) + " at least " + std::to_string(TIKHONOV_FIELD_RATIO) + "x below first-order " + sci(o_field) + " and below the 2 dx layer " + sci(c_field));
+    check(TIKHONOV_ENERGY_RATIO * k_energy < o_energy,
+          "3 dx / Tikhonov EBF: energy error at t = 2R " + sci(k_energy) + " at least " + std::to_string(TIKHONOV_ENERGY_RATIO) + "x below first-order " + sci(o_energy));
+    check(max_energy_increase(K.total_energy) <= 0., "3 dx / Tikhonov EBF: near-field energy non-increasing (samples every R/4)");
   }
 
   // The ABC run gives the same field on 1 and on all ranks.
@@ -651,6 +691,12 @@ namespace
     const double diff = field_difference(world.fields.back(), self.fields.back(), lp.dx);
     check(world.fields.back().size() == self.fields.back().size() && diff <= 1e-24 * sum_squares(self.fields.back()),
           "fields on " + std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) + " ranks and 1 rank agree: sum of squared differences " + sci(diff));
+    // The 3 dx / Tikhonov layer (session 14) likewise.
+    const auto k_world = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_tikhonov_parameters(5.), u0, 6., 1, all, true, MPI_COMM_WORLD);
+    const auto k_self  = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_tikhonov_parameters(5.), u0, 6., 1, all, true, MPI_COMM_SELF);
+    const double k_diff = field_difference(k_world.fields.back(), k_self.fields.back(), lp.dx);
+    check(k_world.fields.back().size() == k_self.fields.back().size() && k_diff <= 1e-24 * sum_squares(k_self.fields.back()),
+          "3 dx / Tikhonov EBF: fields on all ranks and 1 rank agree: " + sci(k_diff));
     // The sponge (per-node damping) likewise.
     const auto s_world = simulate<2>(near, lp, mp, WaveTruncation::sponge, sponge_parameters(), u0, 6., 1, all, true, MPI_COMM_WORLD);
     const auto s_self  = simulate<2>(near, lp, mp, WaveTruncation::sponge, sponge_parameters(), u0, 6., 1, all, true, MPI_COMM_SELF);
@@ -833,12 +879,49 @@ namespace
       }
   }
 
+  /**
+   * Phase pattern of a nodal field @p u on the layer (depth < delta) of the
+   * disc @p R centred at the origin: the correlation sum w Re(u_i conj(u_j))
+   * / sum w (|u_i|^2 + |u_j|^2)/2 over the pairs within sqrt(2) dx, weighted
+   * tangentially ((1 - (n.e)^2)^2) or normally ((n.e)^2): +1 smooth, -1 a
+   * sawtooth (the Verlet FEM layer's unstable mode, session 13). Returns
+   * {tangential, normal}.
+   */
+  std::array<double, 2>
+  layer_correlation(const std::vector<Point<2>> &x, const std::vector<std::complex<double>> &u, const double R,
+                    const LatticeParameters &lp)
+  {
+    double ct = 0., nt = 0., cn = 0., nn = 0.;
+    std::vector<unsigned int> layer;
+    for (unsigned int i = 0; i < u.size(); ++i)
+      if (R - x[i].norm() < lp.delta)
+        layer.push_back(i);
+    for (unsigned int a = 0; a < layer.size(); ++a)
+      for (unsigned int b = a + 1; b < layer.size(); ++b)
+        {
+          const unsigned int i = layer[a], j = layer[b];
+          const Tensor<1, 2> e = x[j] - x[i];
+          if (e.norm() > std::sqrt(2.) * lp.dx * (1. + 1e-6))
+            continue;
+          const Tensor<1, 2> n  = (x[i] + x[j]) / (x[i] + x[j]).norm();
+          const double       c2 = std::pow(n * e / e.norm(), 2);
+          const double       re = std::real(u[i] * std::conj(u[j]));
+          const double       sq = 0.5 * (std::norm(u[i]) + std::norm(u[j]));
+          ct += std::pow(1. - c2, 2) * re;
+          nt += std::pow(1. - c2, 2) * sq;
+          cn += c2 * re;
+          nn += c2 * sq;
+        }
+    return {{ct / nt, cn / nn}};
+  }
+
   /** Spectral radius of the one-step map of a small 2D PD disc (E14 parameters). */
   double
   radius_2d(const double R, const WaveAbcParameters &prm, const double dx = 0.25,
             const double m = 6, unsigned int *n_up = nullptr, WaveCloudStatistics *stats = nullptr,
             std::complex<double> *dominant = nullptr, WaveSpectralDiagnostics *diag = nullptr,
-            const WaveTruncation boundary = WaveTruncation::absorbing, const double dt = 0.02)
+            const WaveTruncation boundary = WaveTruncation::absorbing, const double dt = 0.02,
+            std::vector<Point<2>> *positions = nullptr)
   {
     LatticeParameters lp;
     lp.dx    = dx;
@@ -853,6 +936,8 @@ namespace
     pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, boundary, prm, zero);
     if (stats)
       *stats = pd.absorbing_boundary().statistics();
+    if (positions)
+      *positions = pd.discretization().position;
     if (diag)
       {
         *diag = pd.spectral_diagnostics(20000);
@@ -1211,11 +1296,30 @@ namespace
     unsigned int        n_up = 0;
     WaveCloudStatistics st;
     std::complex<double> dom2;
-    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2);
+    WaveSpectralDiagnostics diag2;
+    std::vector<Point<2>>   x2;
+    const double        rho2 = radius_2d(2.5, p2, 0.25, 6, &n_up, &st, &dom2, &diag2, WaveTruncation::absorbing, 0.02, &x2);
     std::cout << "    2D R = 2.5, cone 0.5: rho - 1 = " << sci(rho2 - 1.) << " (" << n_up << " eigenvalues > 1 + 1e-8), cond "
               << sci(st.max_condition_number) << ", max|V| " << sci(st.max_update_norm) << std::endl;
     check(st.max_condition_number <= 1e12 && st.max_update_norm <= 2. && rho2 > 1. + 1e-4,
           "2D: local guards hold but rho > 1 + 1e-4 (known, doc/design.md)");
+    // Not the Verlet FEM layer's instability (a tangential sawtooth,
+    // correlation -1, removed by a tangential viscosity; session 13): the
+    // growing mode's u in the layer is uncorrelated tangentially (measured
+    // +0.03, normal -0.15), and tangential layer filters do not stabilize
+    // it (doc/design.md, session 14).
+    {
+      LatticeParameters l2;
+      l2.dx          = 0.25;
+      l2.delta       = 6 * l2.dx;
+      const auto cor = layer_correlation(x2, diag2.eigenvector_u, 2.5, l2);
+      std::cout << "    2D dominant mode, layer correlation of u: tangential " << cor[0] << ", normal " << cor[1] << std::endl;
+      double dev = 0.;
+      for (unsigned int i = 0; i < x2.size(); ++i)
+        dev = std::max(dev, std::abs(std::abs(diag2.eigenvector_u[i]) - diag2.mode_u[i]));
+      check(x2.size() == diag2.eigenvector_u.size() && dev < 1e-12, "eigenvector_u: one entry per node, modulus mode_u");
+      check(cor[0] > -0.5 && cor[1] > -0.5, "2D: the growing mode is not a sawtooth along or across the layer");
+    }
     // Where the 2D instability sits: its frequency arg(lambda)/dt is the top
     // of the discrete PD spectrum, max_k sqrt(Omega^2(k) - d^2) over the
     // Brillouin zone |k_i| <= pi/dx (the plateau of short waves with ~zero
@@ -1769,19 +1873,20 @@ namespace
   }
 
   /**
-   * Energy of the E14 near field (disc @p R, e14_stable_parameters(R)) from
+   * Energy of the E14 near field (disc @p R, @p parameters(R)) from
    * rough_state(), sampled @p n_samples times over @p n_steps: every
    * lattice mode is excited, so a growing one cannot hide below round-off
    * as it can behind a smooth pulse.
    */
   std::vector<double>
-  stable_energy_history(const double R, const unsigned long n_steps, const unsigned int n_samples)
+  stable_energy_history(const double R, const unsigned long n_steps, const unsigned int n_samples,
+                        const std::function<WaveAbcParameters(double)> &parameters = e14_stable_parameters)
   {
     LatticeParameters    lp;
     ScalarWaveParameters mp;
     e14_parameters(lp, mp);
     PdUnboundedWave<2> pd(MPI_COMM_WORLD);
-    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, WaveTruncation::absorbing, e14_stable_parameters(R), rough_state());
+    pd.setup(BallDomain<2>(Point<2>(), R), lp, mp, WaveTruncation::absorbing, parameters(R), rough_state());
     return sampled_energy(pd, n_steps, n_samples);
   }
 
@@ -1805,23 +1910,44 @@ namespace
   void
   pd_2d_stable(const bool long_run)
   {
-    if (!long_run && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
-      for (const double dt : {0.02, 0.005})
-        {
-          unsigned int n_up = 0;
-          const double rho  = radius_2d(2.5, e14_stable_parameters(2.5), 0.25, 6, &n_up, nullptr, nullptr, nullptr,
-                                       WaveTruncation::absorbing, dt);
-          std::cout << "    R = 2.5, dt = " << dt << ": rho - 1 = " << sci(rho - 1.) << " (" << n_up << " eigenvalues > 1 + 1e-8)"
-                    << std::endl;
-          check(rho <= 1. + 1e-8, "stable EBF layer, m = 6: one-step spectral radius <= 1 + 1e-8 (R = 2.5, dt = " + std::to_string(dt) + ")");
-        }
-    const unsigned long       n_steps = long_run ? 1000000 : 20000;
-    const std::vector<double> e       = stable_energy_history(8., n_steps, long_run ? 100 : 20);
-    const double              inc     = max_relative_increase(e);
-    if (root())
-      std::cout << "    R = 8, rough state, " << n_steps << " steps: E_end/E0 = " << sci(e.back() / e[0])
-                << ", largest sample-to-sample change " << sci(inc) << " of the previous sample" << std::endl;
-    check(inc < 0., "stable EBF layer: energy decreasing between samples every " + std::to_string(n_steps / (e.size() - 1)) + " steps over " + std::to_string(n_steps) + " steps (largest change " + sci(inc) + ")");
+    // Session 13's 2 dx layer and session 14's 3 dx / Tikhonov layer
+    // (measured: R = 2.5 1 - 6.5e-5 / 1 - 1.3e-5 at dt = 0.02 / 0.005).
+    // The latter is not monotone from the rough state: its energy rises
+    // transiently (non-normal map) to ~130 E0 within ~60 steps and decays
+    // from a few hundred steps on, so its samples are compared from the
+    // first one (after 1000 / 10,000 steps) and the transient is bounded
+    // separately (doc/design.md, session 14).
+    const std::vector<std::tuple<std::string, std::function<WaveAbcParameters(double)>, unsigned int>> settings{
+      {"2 dx", e14_stable_parameters, 0u}, {"3 dx / Tikhonov", e14_tikhonov_parameters, 1u}};
+    for (const auto &[name, parameters, first] : settings)
+      {
+        if (!long_run && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
+          for (const double dt : {0.02, 0.005})
+            {
+              unsigned int n_up = 0;
+              const double rho  = radius_2d(2.5, parameters(2.5), 0.25, 6, &n_up, nullptr, nullptr, nullptr,
+                                           WaveTruncation::absorbing, dt);
+              std::cout << "    " << name << ", R = 2.5, dt = " << dt << ": rho - 1 = " << sci(rho - 1.) << " (" << n_up
+                        << " eigenvalues > 1 + 1e-8)" << std::endl;
+              check(rho <= 1. + 1e-8, name + " EBF layer, m = 6: one-step spectral radius <= 1 + 1e-8 (R = 2.5, dt = " + std::to_string(dt) + ")");
+            }
+        const unsigned long       n_steps = long_run ? 1000000 : 20000;
+        const std::vector<double> e       = stable_energy_history(8., n_steps, long_run ? 100 : 20, parameters);
+        const double              inc     = max_relative_increase(std::vector<double>(e.begin() + first, e.end()));
+        if (root())
+          std::cout << "    " << name << ", R = 8, rough state, " << n_steps << " steps: E_end/E0 = " << sci(e.back() / e[0])
+                    << ", E_1/E0 = " << sci(e[1] / e[0]) << ", largest sample-to-sample change from sample " << first << " "
+                    << sci(inc) << " of the previous sample" << std::endl;
+        check(inc < 0., name + " EBF layer: energy decreasing between samples every " + std::to_string(n_steps / (e.size() - 1)) + " steps from sample " + std::to_string(first) + " over " + std::to_string(n_steps) + " steps (largest change " + sci(inc) + ")");
+        if (first > 0 && !long_run)
+          {
+            // The transient, sampled every 10 steps over the first 500.
+            const std::vector<double> t = stable_energy_history(8., 500, 50, parameters);
+            const double              peak = *std::max_element(t.begin(), t.end()) / t[0];
+            std::cout << "    " << name << ": largest E/E0 over the first 500 steps (every 10) " << sci(peak) << std::endl;
+            check(peak < 300., name + ": transient energy growth from the rough state below 300 E0 (" + sci(peak) + ")");
+          }
+      }
   }
 
   /**
@@ -1871,6 +1997,7 @@ namespace
         prm.direction_range          = num("dphi", prm.direction_range);
         prm.pseudo_inverse_tolerance = num("rcond", 0.);
         prm.fit_form                 = kv.count("form") ? kv["form"] : prm.fit_form;
+        prm.pseudo_inverse_regularization = kv.count("reg") ? kv["reg"] : prm.pseudo_inverse_regularization;
         prm.cone_angle               = num("cone", prm.cone_angle);
         prm.cloud_radius             = num("dinf", 0.);
         prm.n_wave_numbers           = static_cast<unsigned int>(num("nk", prm.n_wave_numbers));
@@ -1941,6 +2068,9 @@ namespace
                             if (Rd - x[i].norm() < lp.delta)
                               angle_max[ab] = std::max(angle_max[ab], m);
                           }
+                        const auto cor = layer_correlation(x, diag.eigenvector_u, Rd, lp);
+                        std::cout << "      layer correlation of u: tangential " << cor[0] << ", normal " << cor[1]
+                                  << std::endl;
                         std::cout << "      max |u| by depth (dx):";
                         for (const auto &e : depth_max)
                           std::cout << " " << e.first << ":" << sci(e.second);
@@ -1978,6 +2108,16 @@ namespace
                 std::cout << " | per-step growth of sqrt(E) over the last tenth "
                           << sci(std::pow(e[10] / e[9], 0.5 / (n / 10)) - 1.) << " (" << sci(timer.cpu_time()) << " s)"
                           << std::endl;
+                // The pattern of the state after the power iteration.
+                const auto &xl = pd.discretization().position;
+                std::vector<std::complex<double>> ul(pd.discretization().n_owned());
+                for (unsigned int i = 0; i < ul.size(); ++i)
+                  ul[i] = pd.displacement().local_element(i);
+                const auto cor = layer_correlation(xl, ul, Rl, lp);
+                // The half-step energy includes the layer nodes' v^{n+1/2},
+                // which advance() computes from a stale acceleration.
+                std::cout << "      layer correlation of u: tangential " << cor[0] << ", normal " << cor[1]
+                          << "; E^{n+1/2}/E0 " << sci(pd.half_step_energy() / e[0]) << std::endl;
               }
             catch (const std::exception &ex)
               {

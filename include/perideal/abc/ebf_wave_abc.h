@@ -65,6 +65,14 @@ namespace PeriDEAL
        */
       double pseudo_inverse_tolerance = 0.;
       /**
+       * How the pseudo-inverse treats the small singular values: "truncate"
+       * (LAPACK's rcond: 1/sigma for sigma > tol sigma_max, else 0) or
+       * "tikhonov" (sigma/(sigma^2 + lambda^2) with lambda = tol sigma_max
+       * for every sigma above the default rank threshold): a continuous
+       * family between two truncation ranks.
+       */
+      std::string pseudo_inverse_regularization = "truncate";
+      /**
        * PD, serial runs: if the state size 2 n_nodes + 2 n_cloud_points is at
        * most this, setup computes the spectral radius of the one-step map
        * (PdUnboundedWave::one_step_spectral_radius) and throws
@@ -293,6 +301,8 @@ namespace PeriDEAL
       std::complex<double> dominant;
       /** |u| and |v| of the dominant eigenvector per owned node (max of both = 1). */
       std::vector<double> mode_u, mode_v;
+      /** The u part of the dominant eigenvector per owned node (same scaling): its phase pattern. */
+      std::vector<std::complex<double>> eigenvector_u;
       /** Share of the squared dominant eigenvector on the absorbing nodes (u, v, old levels). */
       double layer_fraction = 0.;
       /** Share of the squared dominant eigenvector in the v entries of the absorbing nodes. */
