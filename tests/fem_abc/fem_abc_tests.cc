@@ -666,7 +666,9 @@ namespace
    * (lambda = 1e-5 sigma_max; session 15): these clouds are unstable with
    * the truncated pseudo-inverse (rcond 0: radius 1 + 5.1e-3 on (-3, 3)^2)
    * and with lambda = 1e-6 sigma_max (1 + 2.6e-3); lambda = 1e-5
-   * sigma_max makes them stable.
+   * sigma_max makes them stable. The accurate lambda is narrow and moves
+   * with the time step as ~5e-4 dt (E13 dt 0.01: 1e-5 gives 1.8x in the
+   * field, 5e-6 8.3x; doc/design.md, session 15): tuned to dt = 0.02.
    */
   E13
   newmark_tikhonov()
