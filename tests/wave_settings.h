@@ -27,7 +27,7 @@ namespace PeriDEALTests
     return kv;
   }
 
-  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, levels, disp, maxv, thin, curv). */
+  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv). */
   inline PeriDEAL::Abc::WaveAbcParameters
   with_wave_settings(PeriDEAL::Abc::WaveAbcParameters p, const std::map<std::string, std::string> &kv)
   {
@@ -43,6 +43,7 @@ namespace PeriDEALTests
     p.cone_angle               = num("cone", p.cone_angle);
     p.cloud_radius             = num("cloud", p.cloud_radius);
     p.pseudo_inverse_tolerance = num("tol", p.pseudo_inverse_tolerance);
+    p.pseudo_inverse_regularization = str("reg", p.pseudo_inverse_regularization);
     p.n_time_levels            = static_cast<unsigned int>(num("levels", p.n_time_levels));
     p.dispersion               = str("disp", p.dispersion);
     p.max_update_norm          = num("maxv", p.max_update_norm);

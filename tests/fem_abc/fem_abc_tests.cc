@@ -580,7 +580,7 @@ namespace
    * samples 1.3e-20 E0: no growth over 1e6 steps.
    */
   void
-  energy_decay(E13 c, const unsigned int n_steps, const unsigned int every)
+  energy_decay(E13 c, const unsigned int n_steps, const unsigned int every, const bool stationary_floor = false)
   {
     c.fem.time_step   = c.dt;
     const ScalarFunctionFromFunctionObject<2> u0(
@@ -590,7 +590,7 @@ namespace
     Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
     const auto      all = [](const Point<2> &) { return true; };
     const double    e0  = w.energy(all);
-    double          previous = e0, max_increase = 0., max_after = 0.;
+    double          previous = e0, max_increase = 0., max_after = 0., e_mid = 0.;
     unsigned int    n_increase = 0;
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
@@ -603,6 +603,8 @@ namespace
             max_increase = std::max(max_increase, (e - previous) / e0);
             if (2 * s > n_steps)
               max_after = std::max(max_after, e / e0);
+            else
+              e_mid = e / e0;
             previous = e;
           }
       }
@@ -612,7 +614,15 @@ namespace
                 << sci(max_increase) << " E0 (" << n_increase << " increases)" << std::endl;
     check(max_increase <= 1e-10, "energy non-increasing between samples every " + std::to_string(every) +
                                    " steps: largest increase " + sci(max_increase) + " E0 <= 1e-10 E0");
-    check(max_after < 1e-12, "no growth: energy over the second half " + sci(max_after) + " E0 < 1e-12 E0");
+    if (stationary_floor)
+      // The energy settles on a non-decaying floor (see newmark_tikhonov_stability):
+      // no growth means no sample of the second half above the floor at the
+      // midpoint by more than 1 % (a mode growing by r per step exceeds that
+      // for r > 0.02 / n_steps).
+      check(max_after <= 1.01 * e_mid, "no growth: energy over the second half " + sci(max_after) +
+                                         " E0 <= 1.01 x the energy at the midpoint " + sci(e_mid) + " E0");
+    else
+      check(max_after < 1e-12, "no growth: energy over the second half " + sci(max_after) + " E0 < 1e-12 E0");
   }
 
   E13
@@ -648,6 +658,67 @@ namespace
     // split of the defective eigenvalue -1 (~sqrt(eps)).
     check(rho < 1. + 1e-6, "Newmark consistent + curved EBF: radius 1 + " + sci(rho - 1.) + " < 1 + 1e-6");
     energy_decay(c, 20000, 100);
+  }
+
+  /**
+   * Newmark + consistent mass, curved modes (rho 64) with clouds of radius
+   * 2 (4 h, 14-17 points instead of 5-6) and the Tikhonov pseudo-inverse
+   * (lambda = 1e-5 sigma_max; session 15): these clouds are unstable with
+   * the truncated pseudo-inverse (rcond 0: radius 1 + 5.1e-3 on (-3, 3)^2)
+   * and with lambda = 1e-6 sigma_max (1 + 2.6e-3); lambda = 1e-5
+   * sigma_max makes them stable. The accurate lambda is narrow and moves
+   * with the time step as ~5e-4 dt (E13 dt 0.01: 1e-5 gives 1.8x in the
+   * field, 5e-6 8.3x; doc/design.md, session 15): tuned to dt = 0.02.
+   */
+  E13
+  newmark_tikhonov()
+  {
+    E13 c                                 = newmark_consistent();
+    c.abc.curvature_radius                = 64.;
+    c.abc.cloud_radius                    = 2.;
+    c.abc.pseudo_inverse_regularization   = "tikhonov";
+    c.abc.pseudo_inverse_tolerance        = 1e-5;
+    return c;
+  }
+
+  /** One-step radius on (-3, 3)^2 and energy decay over 2e4 steps (energy_decay) of newmark_tikhonov(). */
+  void
+  newmark_tikhonov_stability()
+  {
+    const E13    c   = newmark_tikhonov();
+    const double rho = radius(Fem::WaveBoundary::absorbing, c.abc.pseudo_inverse_tolerance, 1, "Newmark", false, c);
+    // Measured 1 + 4.8e-8: the round-off split of the defective -1 (as in
+    // newmark_curved_stability); the same clouds with lambda = 1e-6
+    // sigma_max: 1 + 2.6e-3 (checked below: the regularization is what
+    // makes them stable).
+    check(rho < 1. + 1e-6, "Newmark + curved EBF, clouds 2, Tikhonov 1e-5: radius 1 + " + sci(rho - 1.) + " < 1 + 1e-6");
+    const double weak = radius(Fem::WaveBoundary::absorbing, 1e-6, 1, "Newmark", false, c);
+    check(weak > 1. + 1e-4, "same clouds, Tikhonov 1e-6: unstable (radius 1 + " + sci(weak - 1.) + ")");
+    // Measured: E falls to 2.19e-10 E0 by t ~ 200 and stays there (1e6
+    // steps, newmark_tikhonov_long: 2.189e-10 E0 at t = 2e4, largest
+    // increase between samples 1.4e-13 E0), where the truncated 5-6 point
+    // clouds settle at 6.1e-18 E0: a non-decaying state of the constant-
+    // preserving update, 1e-10 E0 instead of 1e-18 E0 with the regularized
+    // fits. Asserted: increases <= 1e-10 E0 and no growth above that floor.
+    energy_decay(c, 20000, 100, true);
+  }
+
+  void
+  newmark_tikhonov_long()
+  {
+    energy_decay(newmark_tikhonov(), 1000000, 1000, true);
+  }
+
+  /** E13 with newmark_tikhonov() (long: Newmark + consistent mass, 1600 steps). */
+  void
+  newmark_e13_tikhonov()
+  {
+    const E13Result r = run_e13(newmark_tikhonov(), true);
+    // Measured: energy 2.23e-4 vs 5.27e-3 (23.6x), probe 4.00e-4 vs
+    // 7.13e-3 (17.8x), field at t_end 9.94e-4 vs 8.60e-3 (8.6x; the
+    // issue's 10x is NOT reached, the same late-wake offset as with the
+    // 5-6 point clouds, 9.05x). Margins ~15-20 %.
+    check_e13_ratios(r, "Newmark consistent, curved modes, clouds 2, Tikhonov 1e-5: ", 20., 15., 7.5);
   }
 
   void
@@ -1259,5 +1330,5 @@ namespace
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"newmark_tikhonov_stability", newmark_tikhonov_stability}, {"newmark_e13_tikhonov", newmark_e13_tikhonov}, {"newmark_tikhonov_long", newmark_tikhonov_long}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
 }

@@ -23,3 +23,7 @@ perideal_add_test(NAME fem_abc.e13_verlet_layer COMMAND $<TARGET_FILE:fem_abc_te
 # long-run-stable route: radius and energy decay (unit), E13 ratios (~40 s).
 perideal_add_test(NAME fem_abc.newmark_curved_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_curved_stability LABELS unit)
 perideal_add_test(NAME fem_abc.newmark_e13_curved COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_curved LABELS "convergence;long" TIMEOUT 1200)
+# Session 15: the same with clouds of radius 2 and the Tikhonov pseudo-inverse.
+perideal_add_test(NAME fem_abc.newmark_tikhonov_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_tikhonov_stability LABELS unit)
+perideal_add_test(NAME fem_abc.newmark_tikhonov_long COMMAND $<TARGET_FILE:fem_abc_tests> newmark_tikhonov_long LABELS long TIMEOUT 3000)
+perideal_add_test(NAME fem_abc.newmark_e13_tikhonov COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_tikhonov LABELS "convergence;long" TIMEOUT 1200)
