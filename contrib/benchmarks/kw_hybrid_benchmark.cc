@@ -7,7 +7,7 @@
 //   kw_hybrid_benchmark [--dx 0.25] [--m 8] [--end-time 87.5e-6] [--sigma 0.95]
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
 //                       [--chunk 16] [--half-stencil 0|1] [--grouped-test 0|1]
-//                       [--row-test 0|1] [--box-copy 0..3]
+//                       [--row-test 0|1]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -25,10 +25,7 @@
 // masked kernel of the exact switching test (length_grouped_test, default
 // on; the same q bit for bit); --row-test 0 the grouped kernel's per-offset
 // loads instead of one load per stencil row (row_shared_test, default on;
-// the same q bit for bit); --box-copy 0 copies u into the box by a memmove
-// per run and forms p lazily, bit 1 copies by vector moves (vector_copy),
-// bit 2 forms p in the copy (p_in_copy; default 3, the same values bit for
-// bit). The keys kw_hybrid_state_hash_* are FNV-1a
+// the same q bit for bit). The keys kw_hybrid_state_hash_* are FNV-1a
 // hashes of the final displacement and damage bits of each run.
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
@@ -103,7 +100,7 @@ main(int argc, char **argv)
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
   int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1,
-              row_test = -1, box_copy = -1;
+              row_test = -1;
   std::string dir = "kw-hybrid-benchmark", bound = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
@@ -128,8 +125,6 @@ main(int argc, char **argv)
         grouped_test = std::stoi(value);
       else if (key == "--row-test")
         row_test = std::stoi(value);
-      else if (key == "--box-copy")
-        box_copy = std::stoi(value);
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -157,11 +152,6 @@ main(int argc, char **argv)
     ph.hybrid.length_grouped_test = grouped_test != 0;
   if (row_test >= 0)
     ph.hybrid.row_shared_test = row_test != 0;
-  if (box_copy >= 0)
-    {
-      ph.hybrid.vector_copy = (box_copy & 1) != 0;
-      ph.hybrid.p_in_copy   = (box_copy & 2) != 0;
-    }
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = cpu_seconds() - t0;
@@ -286,8 +276,6 @@ main(int argc, char **argv)
             << "\nkw_hybrid_standard_rows_seconds: " << parts[1]
             << "\nkw_hybrid_wls_rows_seconds: " << parts[2]
             << "\nkw_hybrid_switch_bound_seconds: " << parts[3]
-            << "\nkw_hybrid_box_copies_vector: " << hm->n_box_copies()[0]
-            << "\nkw_hybrid_box_copies_with_p: " << hm->n_box_copies()[2]
             << "\nkw_hybrid_exact_node_tests: " << hm->n_exact_node_tests()
             << "\nkw_hybrid_exact_bond_tests: " << hm->n_exact_bond_tests()
             << "\nkw_hybrid_overstretched_bonds: " << overstretched

@@ -1086,55 +1086,6 @@ namespace PeriDEAL
           p[L] = x[L] + u[L];
       }
     p_stamp[c] = p_epoch;
-    ++p_fills;
-  }
-
-  template <int dim>
-  void
-  HybridBondBasedModel<dim>::copy_runs(const VectorField &u, const bool with_p)
-  {
-    const std::size_t N = sweep_n_alloc;
-    std::array<const double *, dim> ud;
-    std::array<double *, dim>       vd, pd;
-    std::array<const double *, dim> xd;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        ud[d] = u[d].begin();
-        vd[d] = sweep_u.data() + sweep_pad + d * N;
-        pd[d] = sweep_p.data() + sweep_pad + d * N;
-        xd[d] = sweep_x0.data() + sweep_pad + d * N;
-      }
-#ifdef PERIDEAL_HYBRID_SWEEP
-    if (prm.vector_copy)
-      {
-        // The runs are short (KW dx = 0.25: 31,990 runs of 10 nodes on
-        // average; the node order is by cells): a memmove call per run and
-        // dimension cost more than its moves. Masked moves of eight lanes;
-        // p as fill_p_chunk() forms it (off the nodes it stays 0).
-        for (const auto &[i0, L0, n] : fill_runs)
-          for (std::uint32_t k = 0; k < n; k += 8)
-            {
-              const __mmask8 m = n - k >= 8 ? __mmask8(0xFF) : __mmask8((1u << (n - k)) - 1);
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  const __m512d v = _mm512_maskz_loadu_pd(m, ud[d] + i0 + k);
-                  _mm512_mask_storeu_pd(vd[d] + L0 + k, m, v);
-                  if (with_p)
-                    _mm512_mask_storeu_pd(pd[d] + L0 + k, m,
-                                          _mm512_add_pd(_mm512_maskz_loadu_pd(m, xd[d] + L0 + k), v));
-                }
-            }
-        return;
-      }
-#endif
-    for (unsigned int d = 0; d < dim; ++d)
-      for (const auto &[i0, L0, n] : fill_runs)
-        {
-          std::copy(ud[d] + i0, ud[d] + i0 + n, vd[d] + L0);
-          if (with_p)
-            for (std::uint32_t k = 0; k < n; ++k)
-              pd[d][L0 + k] = xd[d][L0 + k] + ud[d][i0 + k];
-        }
   }
 
   template <int dim>
@@ -1422,11 +1373,10 @@ namespace PeriDEAL
         const __mmask8    lanes   = wls_lanes[v];
         const unsigned    classes = lip ? 1u : test_lanes[v];
         const std::size_t L0      = 8 * std::size_t(v);
-        if (!p_all_filled)
-          for_each_p_chunk(L0, [&](const std::size_t c) {
-            if (p_stamp[c] != p_epoch)
-              fill_p_chunk(c);
-          });
+        for_each_p_chunk(L0, [&](const std::size_t c) {
+          if (p_stamp[c] != p_epoch)
+            fill_p_chunk(c);
+        });
         __m512d pi[dim];
         for (unsigned int d = 0; d < dim; ++d)
           pi[d] = _mm512_loadu_pd(p + d * N + L0);
@@ -1919,11 +1869,6 @@ namespace PeriDEAL
     for (unsigned int d = 0; d < dim; ++d)
       mid[d] = int(disc.lattice_size()[d] / 2);
     const Point<dim> xc = disc.lattice_point(mid);
-    // Without a finite s0 nothing is ever critical (and s0 is the same on
-    // every rank).
-    const bool test_now =
-      (n_evaluations++ % prm.check_interval == 0) && std::isfinite(s0) &&
-      (!active_wls_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1);
     if (sweep_on)
       {
         // p and u over the box (the same p as the row loops).
@@ -1937,33 +1882,19 @@ namespace PeriDEAL
         // u into the box; p = (x - x_c) + u only in the chunks read, just
         // before they are read (fill_p_chunk(); KW dx = 0.25: 75 % of the
         // chunks per evaluation on average, all of them in the last ~200 of
-        // the 705 steps, when exact tests occur everywhere), or in the copy
-        // (p_in_copy).
+        // the 705 steps, when exact tests occur everywhere).
         if (++p_epoch == 0)
           {
             std::fill(p_stamp.begin(), p_stamp.end(), 0);
             p_epoch = 1;
           }
-        // p_in_copy: p in the copy while the last lazy evaluation formed
-        // at least half of it (every 16th evaluation forms p lazily again,
-        // to see whether that still holds).
-        if (p_all_filled)
-          ++p_eager_count;
-        else
+        const std::size_t N = sweep_n_alloc;
+        for (unsigned int d = 0; d < dim; ++d)
           {
-            p_fills_lazy  = p_fills;
-            p_eager_count = 0;
-          }
-        p_fills = 0;
-        const bool with_p = prm.p_in_copy && p_fills_lazy >= 0 &&
-                            2 * std::size_t(p_fills_lazy) >= p_stamp.size() && p_eager_count < 15;
-        copy_runs(u, with_p);
-        ++copies[prm.vector_copy ? 0 : 1];
-        p_all_filled = with_p;
-        if (with_p)
-          {
-            std::fill(p_stamp.begin(), p_stamp.end(), p_epoch);
-            ++copies[2];
+            const double *ud = u[d].begin();
+            double       *vd = sweep_u.data() + sweep_pad + d * N;
+            for (const auto &[i0, L0, n] : fill_runs)
+              std::copy(ud + i0, ud + i0 + n, vd + L0);
           }
       }
     else
@@ -1973,7 +1904,10 @@ namespace PeriDEAL
           for (std::size_t i = 0; i < n_local; ++i)
             deformed[dim * i + d] = (x[i][d] - xc[d]) + ud[i];
         }
-    if (test_now)
+    // Without a finite s0 nothing is ever critical (and s0 is the same on
+    // every rank).
+    if ((n_evaluations++ % prm.check_interval == 0) && std::isfinite(s0) &&
+        (!active_wls_rows.empty() || Utilities::MPI::n_mpi_processes(disc.get_mpi_communicator()) > 1))
       switch_critical(u);
     seconds[0] += (cpu_seconds() - start);
 

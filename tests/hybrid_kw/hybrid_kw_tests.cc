@@ -21,8 +21,6 @@
 //             per-offset masked kernel (the same exact node tests too);
 //  row_test:  the same with the grouped kernel's loads shared along the
 //             stencil rows (row_shared_test);
-//  box_copy:  the copy of u into the box by vector moves with p formed in
-//             it = a memmove per run and lazy fills of p;
 //  half_stencil: the half-stencil Omega_s sweep = the full-stencil rows
 //             (broken bonds, switching, damage; forces to round-off);
 //  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
@@ -877,35 +875,6 @@ namespace
             (hm->uses_lattice_sweep() ? "yes" : "no") + ")");
   }
 
-  // (h4) The copy of u into the box by vector moves with p formed in it
-  // (vector_copy, p_in_copy: the defaults) against a memmove per run and
-  // the lazy fills of p, on KW at CI size on 1 or 2 ranks: the same values
-  // bit for bit, so the same slack and exact node tests too. Both new
-  // paths must be taken (lattice sweeps, AVX-512).
-  void
-  box_copy()
-  {
-    const auto [tests_new, tests_old] = check_kw_same(
-      [](HybridMechanicsParameters &) {},
-      [](HybridMechanicsParameters &h) {
-        h.vector_copy = false;
-        h.p_in_copy   = false;
-      },
-      "memmoves and lazy fills of p", "kw-box-copy");
-    check(tests_new == tests_old && tests_new > 0,
-          "the same exact node tests: " + std::to_string(tests_new) + " / " + std::to_string(tests_old));
-    MechanicsSolver<2> s(MPI_COMM_WORLD,
-                         kalthoff_winkler(1., 4., 87.5e-6, "hybrid adaptive", 0.8, "kw-box-copy-count"));
-    s.run();
-    const auto        *hm    = s.hybrid_model();
-    const auto         n     = hm->n_box_copies();
-    const unsigned int steps = s.integrator().step();
-    check(!hm->uses_lattice_sweep() || (n[0] >= steps && n[1] == 0 && n[2] > 0 && n[2] < n[0]),
-          "box copies by vector moves / memmoves / with p: " + std::to_string(n[0]) + " / " +
-            std::to_string(n[1]) + " / " + std::to_string(n[2]) + ", " + std::to_string(steps) +
-            " steps (lattice sweep: " + (hm->uses_lattice_sweep() ? "yes" : "no") + ")");
-  }
-
   // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
   // horizon of the boundary or two of a pre-crack). Its area is a band
   // whose width is proportional to delta, so the fraction depends on delta,
@@ -950,7 +919,6 @@ main(int argc, char **argv)
               {"kw_equivalence", kw_equivalence},
               {"grouped_test", grouped_test},
               {"row_test", row_test},
-              {"box_copy", box_copy},
               {"half_stencil", half_stencil},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

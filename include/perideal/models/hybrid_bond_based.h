@@ -77,23 +77,6 @@ namespace PeriDEAL
      * bit; false keeps the per-offset loads of the grouped kernel.
      */
     bool row_shared_test = true;
-    /**
-     * Lattice sweeps: copy u into the box per run of consecutive nodes by
-     * inline masked vector moves instead of a memmove per run and
-     * dimension (the runs are short: the node order is by cells). The same
-     * values; false keeps the memmoves (test hybrid_kw.box_copy).
-     */
-    bool vector_copy = true;
-    /**
-     * Lattice sweeps: while the exact tests read most of p (at least half
-     * of its chunks at the last evaluation that formed p lazily; every
-     * 16th evaluation is lazy again to check), p = (x - x_c) + u is formed
-     * in the copy of u into the box and the per-vector checks of the lazy
-     * fill are skipped. The same p bit for bit (the same sum of the same
-     * operands); false forms p only where read (test
-     * hybrid_kw.box_copy).
-     */
-    bool p_in_copy = true;
   };
 
   /**
@@ -358,16 +341,6 @@ namespace PeriDEAL
       return rows_on;
     }
     /**
-     * Copies of u into the box (lattice sweeps) by vector moves
-     * (HybridMechanicsParameters::vector_copy), by memmoves, and those that
-     * formed p too (HybridMechanicsParameters::p_in_copy).
-     */
-    std::array<unsigned int, 3>
-    n_box_copies() const
-    {
-      return copies;
-    }
-    /**
      * Number of owned Omega_w rows that use the shared WLS weights of the
      * interior collocation pattern (lattice sweep only; the others keep
      * their own row of weights).
@@ -460,12 +433,6 @@ namespace PeriDEAL
     /** The lattice bound: advance it to the current sweep_u, mark the vectors to test. */
     void
     lattice_bound_vectors();
-    /**
-     * Copy u into the box (the runs of fill_runs); with @p with_p, also
-     * p = (x - x_c) + u at the nodes.
-     */
-    void
-    copy_runs(const VectorField &u, const bool with_p);
     bool
     sweep_standard_rows(VectorField &force);
     /**
@@ -600,16 +567,6 @@ namespace PeriDEAL
     /** Runs (first local node, its box position, length) of consecutive nodes at consecutive positions. */
     std::vector<std::array<std::uint32_t, 3>> fill_runs;
     /**
-     * p_in_copy: chunks of p formed at this evaluation, and at the last
-     * one that formed p lazily (-1: none yet); evaluations since then; p
-     * formed everywhere in the copy at this evaluation (no per-vector
-     * checks).
-     */
-    std::size_t  p_fills = 0;
-    std::int64_t p_fills_lazy = -1;
-    unsigned int p_eager_count = 0;
-    bool         p_all_filled = false;
-    /**
      * Per vector: lanes of shared-pattern WLS rows, of Omega_w rows; the
      * length classes to test (bit k).
      */
@@ -694,7 +651,6 @@ namespace PeriDEAL
     /** @} */
     unsigned int        n_evaluations = 0;
     unsigned int        switch_events = 0;
-    std::array<unsigned int, 3> copies{{0, 0, 0}};
   };
 } // namespace PeriDEAL
 
