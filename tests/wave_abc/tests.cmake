@@ -20,9 +20,12 @@ endforeach()
 # semi-discrete analysis (two dense 2D eigenproblems); the sponge over 1e6 steps;
 # E15 at the source's radii (26, 42; ~270k nodes in all); the stable m = 6
 # EBF layer over 1e6 steps.
-foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full pd_2d_stable_long)
+foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
+# Three layer settings over 1e6 steps each, one with the energy at every step.
+perideal_add_test(NAME wave_abc.pd_2d_stable_long COMMAND $<TARGET_FILE:wave_abc_tests> pd_2d_stable_long
+  LABELS long TIMEOUT 2400)
 perideal_add_test(NAME wave_abc.shared_vectors.np2 NPROCS 2
   COMMAND $<TARGET_FILE:wave_abc_tests> shared_vectors LABELS mpi)
 perideal_add_test(NAME wave_abc.compact_levels.np2 NPROCS 2

@@ -80,6 +80,14 @@ namespace
   constexpr double TIKHONOV_FIELD_RATIO  = 10.;
   constexpr double TIKHONOV_ENERGY_RATIO = 10.;
   /**
+   * The same for the 4 dx wide-cone Tikhonov layer
+   * (e14_monotone_parameters(), session 15), whose energy from the rough
+   * state does not rise: measured field 12.0 (2.80e-4 vs 3.36e-3), energy
+   * 22.6 (6.5e-4 vs 1.46e-2).
+   */
+  constexpr double MONOTONE_FIELD_RATIO  = 10.;
+  constexpr double MONOTONE_ENERGY_RATIO = 10.;
+  /**
    * Shared updating vectors (E14 disc R = 6, t = 2R): largest difference of
    * the fields (per max |u|) and energies (per E0) from those with each
    * node's own vectors. Measured 3.6e-10 and 2.1e-11.
@@ -536,6 +544,29 @@ namespace
     return prm;
   }
 
+  /**
+   * The session-15 layer: curved normal modes and the increment form as
+   * e14_stable_parameters(), clouds of the points within 4 dx (1.0) and a
+   * Cone angle Delta phi of 0.4 (the region (4.86) |y| < cot(Delta phi) |x|
+   * behind x_i: half-angle pi/2 - 0.4 = 1.17 rad; 16-20 points), Tikhonov
+   * lambda = 4e-4 sigma_max. From the rough state the (4.99) energy of the
+   * R = 8 disc falls at every step for 113,935 steps and between samples
+   * >= 20 steps apart over 1e6 steps, where the 3 dx
+   * clouds of e14_tikhonov_parameters() (Delta phi 1, 5-8 points) rise to
+   * 130 E0 first; E14 reduced 12x / 23x closer to the reference than first
+   * order (doc/design.md, session 15). The window is narrow: lambda 3.5e-4
+   * rises at 14 of the first 4000 steps, 4.5e-4 falls to 9.9x.
+   */
+  WaveAbcParameters
+  e14_monotone_parameters(const double disc_radius)
+  {
+    WaveAbcParameters prm             = e14_tikhonov_parameters(disc_radius);
+    prm.cloud_radius                  = 1.;
+    prm.cone_angle                    = 0.4;
+    prm.pseudo_inverse_tolerance      = 4e-4;
+    return prm;
+  }
+
   // E14 (reduced): 2D PD, p = 2, omega_0, chi^2 = 1, d = 0.0125, Delta k = 1,
   // delta = m dx with m = 6 (as in the source), on a disc of radius R
   // against the same code on a disc large enough that nothing reaches its
@@ -584,6 +615,8 @@ namespace
     const auto C   = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_stable_parameters(R), u0, T, n_samples, inner);
     // The 3 dx / Tikhonov layer (session 14).
     const auto K   = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_tikhonov_parameters(R), u0, T, n_samples, inner);
+    // The 4 dx wide-cone Tikhonov layer (session 15).
+    const auto G   = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_monotone_parameters(R), u0, T, n_samples, inner);
     const double norm0 = sum_squares(ref.fields[0]);
     for (unsigned int s = 0; s <= n_samples; ++s)
       if (root())
@@ -668,6 +701,17 @@ namespace
     check(TIKHONOV_ENERGY_RATIO * k_energy < o_energy,
           "3 dx / Tikhonov EBF: energy error at t = 2R " + sci(k_energy) + " at least " + std::to_string(TIKHONOV_ENERGY_RATIO) + "x below first-order " + sci(o_energy));
     check(max_energy_increase(K.total_energy) <= 0., "3 dx / Tikhonov EBF: near-field energy non-increasing (samples every R/4)");
+    const double g_field  = field_difference(G.fields.back(), ref.fields.back(), lp.dx) / norm0;
+    const double g_energy = std::abs(G.energy.back() - ref.energy.back()) / ref.energy[0];
+    if (root())
+      std::cout << "    4 dx / wide cone / Tikhonov EBF at t = 2R: field " << sci(g_field) << " (first-order / it "
+                << o_field / g_field << "), energy " << sci(g_energy) << " (ratio " << o_energy / g_energy << "), clouds "
+                << G.stats.min_cloud_size << ".." << G.stats.max_cloud_size << std::endl;
+    check(MONOTONE_FIELD_RATIO * g_field < o_field && g_field < c_field,
+          "4 dx / wide cone / Tikhonov EBF: field error at t = 2R " + sci(g_field) + " at least " + std::to_string(MONOTONE_FIELD_RATIO) + "x below first-order " + sci(o_field) + " and below the 2 dx layer " + sci(c_field));
+    check(MONOTONE_ENERGY_RATIO * g_energy < o_energy,
+          "4 dx / wide cone / Tikhonov EBF: energy error at t = 2R " + sci(g_energy) + " at least " + std::to_string(MONOTONE_ENERGY_RATIO) + "x below first-order " + sci(o_energy));
+    check(max_energy_increase(G.total_energy) <= 0., "4 dx / wide cone / Tikhonov EBF: near-field energy non-increasing (samples every R/4)");
   }
 
   // The ABC run gives the same field on 1 and on all ranks.
@@ -697,6 +741,12 @@ namespace
     const double k_diff = field_difference(k_world.fields.back(), k_self.fields.back(), lp.dx);
     check(k_world.fields.back().size() == k_self.fields.back().size() && k_diff <= 1e-24 * sum_squares(k_self.fields.back()),
           "3 dx / Tikhonov EBF: fields on all ranks and 1 rank agree: " + sci(k_diff));
+    // The 4 dx wide-cone Tikhonov layer (session 15) likewise.
+    const auto g_world = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_monotone_parameters(5.), u0, 6., 1, all, true, MPI_COMM_WORLD);
+    const auto g_self  = simulate<2>(near, lp, mp, WaveTruncation::absorbing, e14_monotone_parameters(5.), u0, 6., 1, all, true, MPI_COMM_SELF);
+    const double g_diff = field_difference(g_world.fields.back(), g_self.fields.back(), lp.dx);
+    check(g_world.fields.back().size() == g_self.fields.back().size() && g_diff <= 1e-24 * sum_squares(g_self.fields.back()),
+          "4 dx / wide cone / Tikhonov EBF: fields on all ranks and 1 rank agree: " + sci(g_diff));
     // The sponge (per-node damping) likewise.
     const auto s_world = simulate<2>(near, lp, mp, WaveTruncation::sponge, sponge_parameters(), u0, 6., 1, all, true, MPI_COMM_WORLD);
     const auto s_self  = simulate<2>(near, lp, mp, WaveTruncation::sponge, sponge_parameters(), u0, 6., 1, all, true, MPI_COMM_SELF);
@@ -1916,10 +1966,16 @@ namespace
     // transiently (non-normal map) to ~130 E0 within ~60 steps and decays
     // from a few hundred steps on, so its samples are compared from the
     // first one (after 1000 / 10,000 steps) and the transient is bounded
-    // separately (doc/design.md, session 14).
-    const std::vector<std::tuple<std::string, std::function<WaveAbcParameters(double)>, unsigned int>> settings{
-      {"2 dx", e14_stable_parameters, 0u}, {"3 dx / Tikhonov", e14_tikhonov_parameters, 1u}};
-    for (const auto &[name, parameters, first] : settings)
+    // separately (doc/design.md, session 14). Session 15's 4 dx wide-cone
+    // layer: R = 2.5 1 - 1.27e-4 / 1 - 3.2e-5, and its energy is sampled at
+    // every step from step 0 over the CI run (measured: no rise in 2e4
+    // steps; the 2 dx layer rises at 111 of the first 4000 steps, peak
+    // 1.017 E0, and is compared every 1000 steps).
+    const std::vector<std::tuple<std::string, std::function<WaveAbcParameters(double)>, unsigned int, bool>> settings{
+      {"2 dx", e14_stable_parameters, 0u, false},
+      {"3 dx / Tikhonov", e14_tikhonov_parameters, 1u, false},
+      {"4 dx / wide cone / Tikhonov", e14_monotone_parameters, 0u, true}};
+    for (const auto &[name, parameters, first, every_step] : settings)
       {
         if (!long_run && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
           for (const double dt : {0.02, 0.005})
@@ -1932,12 +1988,15 @@ namespace
               check(rho <= 1. + 1e-8, name + " EBF layer, m = 6: one-step spectral radius <= 1 + 1e-8 (R = 2.5, dt = " + std::to_string(dt) + ")");
             }
         const unsigned long       n_steps = long_run ? 1000000 : 20000;
-        const std::vector<double> e       = stable_energy_history(8., n_steps, long_run ? 100 : 20, parameters);
+        // Over 1e6 steps single-step rises do occur (largest 7.5e-5 of the
+        // energy, late in the run): the long run samples every 1e4 steps.
+        const unsigned int        n_samples = every_step && !long_run ? n_steps : long_run ? 100 : 20;
+        const std::vector<double> e         = stable_energy_history(8., n_steps, n_samples, parameters);
         const double              inc     = max_relative_increase(std::vector<double>(e.begin() + first, e.end()));
         if (root())
           std::cout << "    " << name << ", R = 8, rough state, " << n_steps << " steps: E_end/E0 = " << sci(e.back() / e[0])
                     << ", E_1/E0 = " << sci(e[1] / e[0]) << ", largest sample-to-sample change from sample " << first << " "
-                    << sci(inc) << " of the previous sample" << std::endl;
+                    << sci(inc) << " of the previous sample (samples every " << n_steps / n_samples << " steps)" << std::endl;
         check(inc < 0., name + " EBF layer: energy decreasing between samples every " + std::to_string(n_steps / (e.size() - 1)) + " steps from sample " + std::to_string(first) + " over " + std::to_string(n_steps) + " steps (largest change " + sci(inc) + ")");
         if (first > 0 && !long_run)
           {
@@ -1959,7 +2018,11 @@ namespace
    * filter; radii=2.5,4 (spectral discs), dts=0.02 (their time steps),
    * run=1 (E14 reduced field and energy errors at t = 2R), long=n (n steps
    * from a rough state on the disc long_R, default R), diag=1 (where the
-   * dominant eigenvector of the first disc and time step sits).
+   * dominant eigenvector of the first disc and time step sits), trans=n
+   * (the energy from the rough state at every one of n steps on long_R:
+   * peak, the layer's and its kinetic share at the peak, rises between
+   * steps and between samples every N steps; trunc=free or first for the
+   * other truncations).
    */
   void
   e14_scan()
@@ -2122,6 +2185,77 @@ namespace
             catch (const std::exception &ex)
               {
                 std::cout << "    long run: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
+              }
+          }
+        if (num("trans", 0.) > 0.)
+          {
+            // The energy (4.99) from the rough state at every step (disc
+            // long_R, default R): peak, increases between consecutive steps
+            // and between every tenth step, and the layer's share at the peak.
+            WaveAbcParameters q  = prm;
+            const double      Rl = num("long_R", R);
+            q.curvature_radius   = rho > 0. ? Rl : 0.;
+            try
+              {
+                PdUnboundedWave<2> pd(MPI_COMM_SELF);
+                const WaveTruncation tr = kv.count("trunc") && kv["trunc"] == "free" ? WaveTruncation::free :
+                                          kv.count("trunc") && kv["trunc"] == "first" ? WaveTruncation::first_order :
+                                                                                        WaveTruncation::absorbing;
+                pd.setup(BallDomain<2>(Point<2>(), Rl), lp, mp, tr, q, rough_state());
+                const auto          all   = [](const Point<2> &) { return true; };
+                const auto          layer = [&](const Point<2> &p) { return p.norm() > Rl - lp.delta - 1e-9; };
+                const unsigned long n     = static_cast<unsigned long>(num("trans", 0.));
+                std::vector<double> e{pd.energy(all)};
+                double              peak_layer = pd.energy(layer) / e[0], peak_layer_kinetic = 0.;
+                unsigned long       n_up = 0, n_up10 = 0, first_up = 0, peak_step = 0;
+                double              max_rel = -1.;
+                for (unsigned long s = 1; s <= n; ++s)
+                  {
+                    pd.advance();
+                    e.push_back(pd.energy(all));
+                    if (e[s] > e[s - 1])
+                      {
+                        ++n_up;
+                        first_up = first_up ? first_up : s;
+                        max_rel  = std::max(max_rel, e[s] / e[s - 1] - 1.);
+                      }
+                    if (s % 10 == 0 && e[s] > e[s - 10])
+                      ++n_up10;
+                    if (e[s] > e[peak_step])
+                      {
+                        peak_step  = s;
+                        peak_layer = pd.energy(layer) / e[s];
+                        // Kinetic part of the layer's share.
+                        peak_layer_kinetic = 0.;
+                        const auto &x      = pd.discretization().position;
+                        for (unsigned int i = 0; i < x.size() && i < pd.discretization().n_owned(); ++i)
+                          if (layer(x[i]))
+                            peak_layer_kinetic += 0.5 * std::pow(pd.velocity().local_element(i), 2) *
+                                                  pd.discretization().volume[i];
+                        peak_layer_kinetic /= e[s];
+                      }
+                  }
+                std::cout << "    transient R = " << Rl << ", " << n << " steps: peak E/E0 " << sci(e[peak_step] / e[0])
+                          << " at step " << peak_step << " (layer share " << sci(peak_layer) << ", of it kinetic " << sci(peak_layer_kinetic)
+                          << "), E_end/E0 "
+                          << sci(e.back() / e[0]) << ", steps with E up " << n_up << " (first " << first_up
+                          << ", largest " << sci(max_rel) << "), 10-step samples up " << n_up10 << std::endl;
+                // The shortest sampling interval (of these) at which every
+                // sample from step 0 is below the previous one.
+                std::cout << "      samples every N steps from 0 with E up:";
+                for (const unsigned long every : {1ul, 10ul, 20ul, 50ul, 100ul, 200ul, 500ul, 1000ul, 10000ul})
+                  if (every <= n / 2)
+                    {
+                      unsigned int ups = 0;
+                      for (unsigned long s = every; s <= n; s += every)
+                        ups += e[s] > e[s - every];
+                      std::cout << " " << every << ":" << ups;
+                    }
+                std::cout << std::endl;
+              }
+            catch (const std::exception &ex)
+              {
+                std::cout << "    transient: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
               }
           }
         if (num("run", 0.) > 0.)

@@ -588,6 +588,12 @@ namespace PeriDEAL
       {
         return u;
       }
+      /** The velocities v^n (the absorbing nodes' extrapolated ones included). */
+      const Vector &
+      velocity() const
+      {
+        return v;
+      }
       /** The dispersion relation used by the ABC (after setup with absorbing). */
       const WaveDispersion<dim> &
       dispersion() const
