@@ -593,6 +593,11 @@ namespace PeriDEAL
           check_parameter(prm.fit_form == "value" || prm.fit_form == "increment", "Absorbing boundary/Fit form",
                           prm.fit_form, "value or increment");
           const bool increment = prm.fit_form == "increment";
+          check_parameter(prm.pseudo_inverse_regularization == "truncate" ||
+                            (prm.pseudo_inverse_regularization == "tikhonov" && prm.pseudo_inverse_tolerance > 0.),
+                          "Absorbing boundary/Pseudo-inverse regularization", prm.pseudo_inverse_regularization,
+                          "truncate, or tikhonov with a Pseudo-inverse tolerance > 0");
+          const bool tikhonov = prm.pseudo_inverse_regularization == "tikhonov";
           for (; stride <= 8 && !ok; ++stride)
             {
               // Auxiliary grid of spacing stride * dx in the local frame
@@ -694,11 +699,6 @@ namespace PeriDEAL
                         MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
                       }
                 }
-              check_parameter(prm.pseudo_inverse_regularization == "truncate" ||
-                                (prm.pseudo_inverse_regularization == "tikhonov" && prm.pseudo_inverse_tolerance > 0.),
-                              "Absorbing boundary/Pseudo-inverse regularization", prm.pseudo_inverse_regularization,
-                              "truncate, or tikhonov with a Pseudo-inverse tolerance > 0");
-              const bool tikhonov = prm.pseudo_inverse_regularization == "tikhonov";
               fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
               fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
               if (increment)

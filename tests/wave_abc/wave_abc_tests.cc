@@ -293,6 +293,23 @@ namespace
         thrown = std::string(e.what()).find("Wave number range") != std::string::npos;
       }
     check(thrown, "Delta k > pi/dx throws ParameterError naming 'Wave number range' (4.83)");
+    // Tikhonov needs lambda = tolerance * sigma_max > 0.
+    thrown = false;
+    try
+      {
+        WaveAbcParameters prm;
+        prm.cloud_radius                  = 0.6;
+        prm.pseudo_inverse_regularization = "tikhonov";
+        EbfWaveAbc<1> abc;
+        Tensor<1, 1>  n;
+        n[0] = 1.;
+        abc.reinit(points, ids, {0}, {n}, WaveDispersion<1>::local(1., 0.), dt, dx, prm, MPI_COMM_SELF);
+      }
+    catch (const ParameterError &e)
+      {
+        thrown = std::string(e.what()).find("Pseudo-inverse regularization") != std::string::npos;
+      }
+    check(thrown, "tikhonov with Pseudo-inverse tolerance 0 throws ParameterError naming 'Pseudo-inverse regularization'");
   }
 
 
