@@ -276,40 +276,32 @@ namespace
         abc.compute(u.data(), uo.data(), v.data(), vo.data(), un, vn);
         check(std::abs(un[0] - std::cos(w.real() * (t + dt))) > 1e-4, name + ": an incoming wave is not extrapolated");
       }
+    // Bad input stops reinit() with a ParameterError naming the entry.
+    const auto throws_naming = [&](const WaveAbcParameters &prm, const std::string &entry) {
+      try
+        {
+          EbfWaveAbc<1> abc;
+          Tensor<1, 1>  n;
+          n[0] = 1.;
+          abc.reinit(points, ids, {0}, {n}, WaveDispersion<1>::local(1., 0.), dt, dx, prm, MPI_COMM_SELF);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(entry) != std::string::npos;
+        }
+      return false;
+    };
     // (4.83).
-    bool thrown = false;
-    try
-      {
-        WaveAbcParameters prm;
-        prm.wave_number_range = 1.01 * M_PI / dx;
-        prm.cloud_radius      = 0.6;
-        EbfWaveAbc<1> abc;
-        Tensor<1, 1>  n;
-        n[0] = 1.;
-        abc.reinit(points, ids, {0}, {n}, WaveDispersion<1>::local(1., 0.), dt, dx, prm, MPI_COMM_SELF);
-      }
-    catch (const ParameterError &e)
-      {
-        thrown = std::string(e.what()).find("Wave number range") != std::string::npos;
-      }
-    check(thrown, "Delta k > pi/dx throws ParameterError naming 'Wave number range' (4.83)");
+    WaveAbcParameters wide;
+    wide.wave_number_range = 1.01 * M_PI / dx;
+    wide.cloud_radius      = 0.6;
+    check(throws_naming(wide, "Wave number range"), "Delta k > pi/dx throws ParameterError naming 'Wave number range' (4.83)");
     // Tikhonov needs lambda = tolerance * sigma_max > 0.
-    thrown = false;
-    try
-      {
-        WaveAbcParameters prm;
-        prm.cloud_radius                  = 0.6;
-        prm.pseudo_inverse_regularization = "tikhonov";
-        EbfWaveAbc<1> abc;
-        Tensor<1, 1>  n;
-        n[0] = 1.;
-        abc.reinit(points, ids, {0}, {n}, WaveDispersion<1>::local(1., 0.), dt, dx, prm, MPI_COMM_SELF);
-      }
-    catch (const ParameterError &e)
-      {
-        thrown = std::string(e.what()).find("Pseudo-inverse regularization") != std::string::npos;
-      }
-    check(thrown, "tikhonov with Pseudo-inverse tolerance 0 throws ParameterError naming 'Pseudo-inverse regularization'");
+    WaveAbcParameters tikhonov;
+    tikhonov.cloud_radius                  = 0.6;
+    tikhonov.pseudo_inverse_regularization = "tikhonov";
+    check(throws_naming(tikhonov, "Pseudo-inverse regularization"),
+          "tikhonov with Pseudo-inverse tolerance 0 throws ParameterError naming 'Pseudo-inverse regularization'");
   }
 
 
