@@ -117,7 +117,7 @@ struct WaveOverhead
 // order, each block after one untimed step in its mode. Per round,
 // (T_abc - T_none) / T_abc; the key is the median over the rounds.
 WaveOverhead
-pd_wave_fraction(const double R, const unsigned int steps, const bool share)
+pd_wave_fraction(const double R, const unsigned int steps, const Abc::WaveAbcParameters &ap)
 {
   LatticeParameters lp;
   lp.dx    = 0.25;
@@ -126,9 +126,6 @@ pd_wave_fraction(const double R, const unsigned int steps, const bool share)
   mp.exponent  = 2.;
   mp.damping   = 0.0125;
   mp.time_step = 0.02;
-  Abc::WaveAbcParameters ap;
-  ap.cone_angle             = 0.5;
-  ap.share_updating_vectors = share;
   Abc::PdUnboundedWave<2> run(MPI_COMM_WORLD);
   run.setup(BallDomain<2>(Point<2>(), R), lp, mp, Abc::WaveTruncation::absorbing, ap, Gaussian<2>());
   WaveOverhead o;
@@ -206,16 +203,37 @@ main(int argc, char **argv)
       else
         steps = std::atoi(argv[i]);
     }
-  const WaveOverhead wave2 = pd_wave_fraction(26., steps, share);
-  if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-    std::cout << "abc_overhead_fraction_pd_2d: " << wave2.fraction << "\n"
-              << "abc_overhead_fraction_pd_2d_vs_no_abc: " << wave2.fraction_vs_no_abc << "\n"
-              << "abc_timer_fraction_of_sums_pd_2d: " << wave2.fraction_of_sums << "\n"
-              << "abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds << "\n"
-              << "no_abc_step_cpu_seconds_pd_2d: " << wave2.step_seconds_no_abc << "\n"
-              << "abc_updating_vector_sets_pd_2d: " << wave2.n_classes << "\n"
-              << "abc_clouds_pd_2d: " << wave2.n_clouds << "\n"
-              << "abc_shared_updating_vector_difference_pd_2d: " << wave2.shared_difference << std::endl;
+  const double R = 26.;
+  Abc::WaveAbcParameters plane;
+  plane.cone_angle             = 0.5;
+  plane.share_updating_vectors = share;
+  // The long-run monotone layer adopted for E14 in session 15
+  // (e14_monotone_parameters() of tests/wave_abc): discrete relation, curved
+  // normal modes rho = R, increment form, clouds of 4 dx (16-20 points per
+  // dot product instead of 5-8), Delta phi 0.4, Tikhonov 4e-4.
+  Abc::WaveAbcParameters monotone = plane;
+  monotone.dispersion                    = "discrete";
+  monotone.n_directions                  = 0;
+  monotone.curvature_radius              = R;
+  monotone.cloud_radius                  = 1.;
+  monotone.cone_angle                    = 0.4;
+  monotone.pseudo_inverse_tolerance      = 4e-4;
+  monotone.pseudo_inverse_regularization = "tikhonov";
+  monotone.fit_form                      = "increment";
+  for (const auto &[suffix, ap] : {std::pair{std::string(""), plane}, std::pair{std::string("_monotone"), monotone}})
+    {
+      const WaveOverhead wave2 = pd_wave_fraction(R, steps, ap);
+      if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+        std::cout << "abc_overhead_fraction_pd_2d" << suffix << ": " << wave2.fraction << "\n"
+                  << "abc_overhead_fraction_pd_2d" << suffix << "_vs_no_abc: " << wave2.fraction_vs_no_abc << "\n"
+                  << "abc_timer_fraction_of_sums_pd_2d" << suffix << ": " << wave2.fraction_of_sums << "\n"
+                  << "abc_step_cpu_seconds_pd_2d" << suffix << ": " << wave2.step_seconds << "\n"
+                  << "no_abc_step_cpu_seconds_pd_2d" << suffix << ": " << wave2.step_seconds_no_abc << "\n"
+                  << "abc_updating_vector_sets_pd_2d" << suffix << ": " << wave2.n_classes << "\n"
+                  << "abc_clouds_pd_2d" << suffix << ": " << wave2.n_clouds << "\n"
+                  << "abc_shared_updating_vector_difference_pd_2d" << suffix << ": " << wave2.shared_difference
+                  << std::endl;
+    }
   if (wave_only)
     return 0;
   const double pd2 = pd_fraction<2>(4., 1. / 16., steps);
