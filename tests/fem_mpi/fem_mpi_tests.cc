@@ -537,6 +537,8 @@ namespace
     bool series = false;
     /** Print the error at t = T by boundary angle and by depth. */
     bool where = false;
+    /** Print the clouds of the absorbing DoFs of the first quadrant. */
+    bool clouds = false;
   };
 
   DiskWaveResult
@@ -566,6 +568,29 @@ namespace
       std::cout << "  disk: " << st.n_absorbing << " absorbing DoFs, clouds " << st.min_cloud_size << ".."
                 << st.max_cloud_size << " stride " << st.max_stride << ", cond " << sci(st.max_condition_number)
                 << ", max|V| " << sci(st.max_update_norm) << std::endl;
+    if (diag.clouds && root())
+      {
+        // Per absorbing DoF in the first quadrant: angle, cloud (x_i first)
+        // as (depth along -n, tangential offset) pairs, max |V_G|, sum |V_G|.
+        const auto &lay  = ebf.layout();
+        const auto &abcb = ebf.absorbing_boundary();
+        for (unsigned int a = 0; a < abcb.absorbing_points().size(); ++a)
+          {
+            const Point<2> &x  = lay.points[abcb.absorbing_points()[a]];
+            const double    an = std::atan2(x[1], x[0]);
+            if (an < -1e-9 || an > M_PI / 2. + 1e-9)
+              continue;
+            const Tensor<1, 2> n = x / x.norm();
+            std::cout << "    angle " << an * 180. / M_PI << ":";
+            for (const unsigned int j : abcb.cloud(a))
+              {
+                const Tensor<1, 2> dx = lay.points[j] - x;
+                std::cout << " (" << -(dx * n) << ", " << dx[0] * (-n[1]) + dx[1] * n[0] << ")";
+              }
+            std::cout << " max|V| " << abcb.cloud_info(a).vmax_g << " sum|V| " << abcb.cloud_info(a).row_sum_g
+                      << std::endl;
+          }
+      }
     const auto inside = [R](const Point<2> &p) { return p.norm() < R - 0.5; };
     const double       e0      = ref.energy(inside);
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
@@ -725,7 +750,8 @@ namespace
   // newmark=1, level (near refinement at R = 8), cloudh (d_inf / h),
   // x0, y0 (pulse centre; diagnostic), series=1 (signed energy errors and
   // max vertex errors, boundary / inside, at every sample), where=1 (error
-  // at T by boundary angle and by depth), and
+  // at T by boundary angle and by depth), clouds=1 (the clouds of the
+  // first quadrant), and
   // rho=R0 (one-step spectral radius on disk(R0, 3 + log2(R0/2)), the
   // boundary spacing of the disk_wave mesh) or rhoonly=1 (no run).
   void
@@ -790,6 +816,7 @@ namespace
                 diag.centre = Point<2>(num("x0", 0.), num("y0", 0.));
                 diag.series = kv.count("series") > 0;
                 diag.where  = kv.count("where") > 0;
+                diag.clouds = kv.count("clouds") > 0;
                 const auto r = run_disk_wave(disk(R, level), disk(R_ref, static_cast<unsigned int>(num("ref", level + 1))),
                                              R, T, ap, kv.count("newmark") > 0, diag);
                 if (root())
