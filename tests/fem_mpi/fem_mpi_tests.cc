@@ -630,6 +630,14 @@ namespace
                             << sci((ebf.energy(inside) - er) / e0) << " first " << sci((first.energy(inside) - er) / e0)
                             << " | field bdry EBF " << sci(fb_e) << " first " << sci(fb_f) << " inside EBF "
                             << sci(fi_e) << " first " << sci(fi_f) << std::endl;
+                // Signed values at the centre and at (R, 0): ref, EBF - ref, first - ref.
+                for (const Point<2> &q : {Point<2>(), Point<2>(R, 0.), Point<2>(R / std::sqrt(2.), R / std::sqrt(2.))})
+                  {
+                    const double uq = ref.value_at(q), eq = ebf.value_at(q), fq = first.value_at(q);
+                    if (root())
+                      std::cout << "      at (" << q << "): ref " << sci(uq) << " EBF-ref " << sci(eq - uq)
+                                << " first-ref " << sci(fq - uq) << std::endl;
+                  }
               }
           }
       }
