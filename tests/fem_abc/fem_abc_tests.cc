@@ -467,6 +467,29 @@ namespace
         named = std::string(e.what()).find("Curvature radius") != std::string::npos;
       }
     check(named, "Curvature radius below the cloud radius rejected naming Absorbing boundary/Curvature radius");
+    // Session 17 options: an unknown wake mode, a wake radius inside the cloud.
+    const auto wake_rejected = [](const std::string &modes, const double radius, const std::string &parameter) {
+      E13 c                       = e13_default();
+      c.fem.time_step             = 0.01;
+      c.abc.wake_modes            = modes;
+      c.abc.wake_curvature_radius = radius;
+      const ScalarFunctionFromFunctionObject<2> u0(pulse);
+      Triangulation<2>                          tria;
+      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
+      try
+        {
+          Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(parameter) != std::string::npos;
+        }
+      return false;
+    };
+    check(wake_rejected("s,bogus", 0., "Wake modes"), "unknown wake mode rejected naming Absorbing boundary/Wake modes");
+    check(!wake_rejected("linear", 0., "Wake modes"), "Wake modes = linear accepted");
+    check(wake_rejected("none", 0.5, "Wake curvature radius"),
+          "Wake curvature radius below the cloud radius rejected naming Absorbing boundary/Wake curvature radius");
   }
   /**
    * Backward Euler diffusion with the EBF ABC on (-1, 1)^2, h = 0.125, Q1
