@@ -27,7 +27,7 @@ namespace PeriDEALTests
     return kv;
   }
 
-  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv). */
+  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wake, wakew, wcurv, wk). */
   inline PeriDEAL::Abc::WaveAbcParameters
   with_wave_settings(PeriDEAL::Abc::WaveAbcParameters p, const std::map<std::string, std::string> &kv)
   {
@@ -49,6 +49,10 @@ namespace PeriDEALTests
     p.max_update_norm          = num("maxv", p.max_update_norm);
     p.thinning                 = str("thin", p.thinning);
     p.curvature_radius         = num("curv", p.curvature_radius);
+    p.wake_modes               = str("wake", p.wake_modes);
+    p.wake_mode_weight         = num("wakew", p.wake_mode_weight);
+    p.wake_curvature_radius    = num("wcurv", p.wake_curvature_radius);
+    p.wake_wave_number         = num("wk", p.wake_wave_number);
     return p;
   }
 } // namespace PeriDEALTests

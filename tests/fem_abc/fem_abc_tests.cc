@@ -467,6 +467,29 @@ namespace
         named = std::string(e.what()).find("Curvature radius") != std::string::npos;
       }
     check(named, "Curvature radius below the cloud radius rejected naming Absorbing boundary/Curvature radius");
+    // Session 17 options: an unknown wake mode, a wake radius inside the cloud.
+    const auto wake_rejected = [](const std::string &modes, const double radius, const std::string &parameter) {
+      E13 c                       = e13_default();
+      c.fem.time_step             = 0.01;
+      c.abc.wake_modes            = modes;
+      c.abc.wake_curvature_radius = radius;
+      const ScalarFunctionFromFunctionObject<2> u0(pulse);
+      Triangulation<2>                          tria;
+      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
+      try
+        {
+          Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(parameter) != std::string::npos;
+        }
+      return false;
+    };
+    check(wake_rejected("s,bogus", 0., "Wake modes"), "unknown wake mode rejected naming Absorbing boundary/Wake modes");
+    check(!wake_rejected("linear", 0., "Wake modes"), "Wake modes = linear accepted");
+    check(wake_rejected("none", 0.5, "Wake curvature radius"),
+          "Wake curvature radius below the cloud radius rejected naming Absorbing boundary/Wake curvature radius");
   }
   /**
    * Backward Euler diffusion with the EBF ABC on (-1, 1)^2, h = 0.125, Q1
@@ -719,6 +742,52 @@ namespace
     // issue's 10x is NOT reached, the same late-wake offset as with the
     // 5-6 point clouds, 9.05x). Margins ~15-20 %.
     check_e13_ratios(r, "Newmark consistent, curved modes, clouds 2, Tikhonov 1e-5: ", 20., 15., 7.5);
+  }
+
+  /**
+   * Session 17: newmark_e13_curved with n_phi 4, n_k 20 and the wake
+   * curvature radius 28 for the k = 0 modes (Absorbing boundary/Wake
+   * curvature radius, Wake wave number 0): the long waves get the larger
+   * decay of the late 2D wake while the front keeps rho 64.
+   */
+  E13
+  newmark_wake_curvature()
+  {
+    E13 c                       = newmark_consistent();
+    c.abc.curvature_radius      = 64.;
+    c.abc.n_directions          = 4;
+    c.abc.n_wave_numbers        = 20;
+    c.abc.wake_curvature_radius = 28.;
+    c.abc.wake_wave_number      = 0.;
+    return c;
+  }
+
+  /** One-step radius on (-3, 3)^2 and energy decay over 2e4 steps (energy_decay) of newmark_wake_curvature(). */
+  void
+  newmark_wake_stability()
+  {
+    const E13    c   = newmark_wake_curvature();
+    const double rho = radius(Fem::WaveBoundary::absorbing, 0., 1, "Newmark", false, c);
+    // Measured 1 + 4.3e-8 (dominant -1): the round-off split of the
+    // defective -1 of the prescribed-velocity recursion, as in
+    // newmark_curved_stability. Energy (measured): largest increase
+    // 1.3e-19 E0, 6.8e-18 E0 at t = 400, as without the wake radius.
+    check(rho < 1. + 1e-6, "Newmark + curved EBF, wake curvature 28: radius 1 + " + sci(rho - 1.) + " < 1 + 1e-6");
+    energy_decay(c, 20000, 100);
+  }
+
+  /** E13 with newmark_wake_curvature(). */
+  void
+  newmark_e13_wake()
+  {
+    const E13Result r = run_e13(newmark_wake_curvature(), true);
+    // Measured: energy 4.28e-4 vs 5.27e-3 (12.3x), probe 2.35e-4 vs
+    // 7.13e-3 (30x), field at t_end 8.78e-4 vs 8.60e-3 (9.79x; the issue's
+    // 10x is NOT reached; without the wake radius 9.06e-4, 9.5x). The run
+    // is deterministic (same numbers on every run): the field factor is
+    // asserted 3 % below the measured one so that it shows the gain over
+    // the 9.5x without the option, energy and probe ~20 % below.
+    check_e13_ratios(r, "Newmark consistent, curved modes, wake curvature 28: ", 10., 25., 9.5);
   }
 
   void
@@ -1330,5 +1399,5 @@ namespace
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"newmark_tikhonov_stability", newmark_tikhonov_stability}, {"newmark_e13_tikhonov", newmark_e13_tikhonov}, {"newmark_tikhonov_long", newmark_tikhonov_long}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"newmark_tikhonov_stability", newmark_tikhonov_stability}, {"newmark_e13_tikhonov", newmark_e13_tikhonov}, {"newmark_tikhonov_long", newmark_tikhonov_long}, {"newmark_wake_stability", newmark_wake_stability}, {"newmark_e13_wake", newmark_e13_wake}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
 }
