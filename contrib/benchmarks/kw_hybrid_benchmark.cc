@@ -7,7 +7,7 @@
 //   kw_hybrid_benchmark [--dx 0.25] [--m 8] [--end-time 87.5e-6] [--sigma 0.95]
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
 //                       [--chunk 16] [--half-stencil 0|1] [--grouped-test 0|1]
-//                       [--row-test 0|1]
+//                       [--row-test 0|1] [--node-order lattice|cells]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -25,8 +25,13 @@
 // masked kernel of the exact switching test (length_grouped_test, default
 // on; the same q bit for bit); --row-test 0 the grouped kernel's per-offset
 // loads instead of one load per stencil row (row_shared_test, default on;
-// the same q bit for bit). The keys kw_hybrid_state_hash_* are FNV-1a
-// hashes of the final displacement and damage bits of each run.
+// the same q bit for bit). --node-order cells numbers the hybrid run's nodes
+// by cells, as the standard run's (LatticeParameters::lattice_order; the
+// default lattice numbers them by lattice rows, so that its per-step copy
+// of u into the lattice box is one run per dimension; the same results).
+// The keys kw_hybrid_state_hash_* are FNV-1a hashes of the final
+// displacement and damage bits of each run, node by node in the standard
+// run's (cell) order for both runs.
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
 // at y = +-25). The source uses dx = 0.25 mm, delta = 2 mm (m = 8) and
@@ -76,20 +81,40 @@ namespace
     return std::vector<double>(phi.begin(), phi.begin() + s.discretization().n_owned());
   }
 
-  /** FNV-1a of the bits of the final displacement and damage (one rank). */
+  /**
+   * FNV-1a of the bits of the final displacement and damage (one rank), node
+   * by node in the order @p order (local indices of @p s; the same ids in
+   * the same order for both runs, whatever their numbering).
+   */
   std::uint64_t
-  state_hash(const MechanicsSolver<2> &s, const std::vector<double> &damage)
+  state_hash(const MechanicsSolver<2> &s, const std::vector<double> &damage,
+             const std::vector<unsigned int> &order)
   {
     std::uint64_t hash = 1469598103934665603ull;
-    const auto    add  = [&](const double *a, const std::size_t n) {
-      const auto *bytes = reinterpret_cast<const unsigned char *>(a);
-      for (std::size_t k = 0; k < n * sizeof(double); ++k)
+    const auto    add  = [&](const double v) {
+      const auto *bytes = reinterpret_cast<const unsigned char *>(&v);
+      for (std::size_t k = 0; k < sizeof(double); ++k)
         hash = (hash ^ bytes[k]) * 1099511628211ull;
     };
     for (unsigned int d = 0; d < 2; ++d)
-      add(s.integrator().displacement[d].begin(), s.discretization().n_owned());
-    add(damage.data(), damage.size());
+      for (const unsigned int i : order)
+        add(s.integrator().displacement[d].local_element(i));
+    for (const unsigned int i : order)
+      add(damage[i]);
     return hash;
+  }
+
+  /** Local index in @p s of each node of @p reference, in @p reference's order. */
+  std::vector<unsigned int>
+  same_nodes(const MechanicsSolver<2> &s, const MechanicsSolver<2> &reference)
+  {
+    std::map<types::particle_index, unsigned int> local;
+    for (unsigned int i = 0; i < s.discretization().n_owned(); ++i)
+      local[s.discretization().id[i]] = i;
+    std::vector<unsigned int> order;
+    for (unsigned int i = 0; i < reference.discretization().n_owned(); ++i)
+      order.push_back(local.at(reference.discretization().id[i]));
+    return order;
   }
 } // namespace
 
@@ -101,7 +126,7 @@ main(int argc, char **argv)
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
   int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1,
               row_test = -1;
-  std::string dir = "kw-hybrid-benchmark", bound = "lattice";
+  std::string dir = "kw-hybrid-benchmark", bound = "lattice", node_order = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
       const std::string key = argv[a], value = argv[a + 1];
@@ -125,6 +150,8 @@ main(int argc, char **argv)
         grouped_test = std::stoi(value);
       else if (key == "--row-test")
         row_test = std::stoi(value);
+      else if (key == "--node-order" && (value == "lattice" || value == "cells"))
+        node_order = value;
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -152,6 +179,7 @@ main(int argc, char **argv)
     ph.hybrid.length_grouped_test = grouped_test != 0;
   if (row_test >= 0)
     ph.hybrid.row_shared_test = row_test != 0;
+  ph.lattice.lattice_order = node_order == "lattice";
   MechanicsSolver<2> hybrid(MPI_COMM_WORLD, ph);
   hybrid.setup();
   const double hybrid_setup = cpu_seconds() - t0;
@@ -200,16 +228,21 @@ main(int argc, char **argv)
   // Damage maps: largest difference, and the cracked nodes (damage >= 0.35)
   // of one run farther than 2 dx from every cracked node of the other (the
   // criterion of tests/hybrid_kw).
+  // Node i of the standard run is node h_of[i] of the hybrid run.
   const auto           ds = damage_of(standard), dh = damage_of(hybrid);
+  const auto           h_of = same_nodes(hybrid, standard);
+  std::vector<unsigned int> s_order(ds.size());
+  for (unsigned int i = 0; i < s_order.size(); ++i)
+    s_order[i] = i;
   const auto          &x  = standard.discretization().position;
   double               max_diff = 0.;
   std::vector<unsigned int> cracked[2];
   for (std::size_t i = 0; i < ds.size(); ++i)
     {
-      max_diff = std::max(max_diff, std::abs(ds[i] - dh[i]));
+      max_diff = std::max(max_diff, std::abs(ds[i] - dh[h_of[i]]));
       if (ds[i] >= 0.35)
         cracked[0].push_back(i);
-      if (dh[i] >= 0.35)
+      if (dh[h_of[i]] >= 0.35)
         cracked[1].push_back(i);
     }
   unsigned int unmatched[2] = {0, 0};
@@ -268,6 +301,7 @@ main(int argc, char **argv)
             << hm->n_exact_bond_tests() << ")\n\n";
   std::cout << std::setprecision(6) << "kw_hybrid_nodes: " << standard.discretization().n_global()
             << "\nkw_hybrid_m: " << m << "\nkw_hybrid_steps: " << hybrid.integrator().step()
+            << "\nkw_hybrid_node_order: " << node_order
             << "\nkw_hybrid_load_average: " << load[0]
             << "\nkw_hybrid_standard_seconds: " << ts << "\nkw_hybrid_adaptive_seconds: " << th
             << "\nkw_hybrid_initial_standard_percent: " << 100. * initial
@@ -287,8 +321,8 @@ main(int argc, char **argv)
             << "\nkw_hybrid_cracked_nodes_unmatched: " << unmatched[0] + unmatched[1]
             << "\nkw_hybrid_speedup_median_chunk: " << median_ratio
             << std::hex << std::setfill('0') << "\nkw_hybrid_state_hash_standard: " << std::setw(16)
-            << state_hash(standard, ds) << "\nkw_hybrid_state_hash_adaptive: " << std::setw(16)
-            << state_hash(hybrid, dh) << std::dec << std::setfill(' ')
+            << state_hash(standard, ds, s_order) << "\nkw_hybrid_state_hash_adaptive: " << std::setw(16)
+            << state_hash(hybrid, dh, h_of) << std::dec << std::setfill(' ')
             << "\nkw_speedup_hybrid_adaptive_over_standard: " << ts / th << std::endl;
   return 0;
 }

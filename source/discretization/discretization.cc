@@ -38,6 +38,12 @@ namespace PeriDEAL
                       "outside the body; 0: none (homogeneous nonlocal Neumann by "
                       "omission of missing neighbours); a negative value means the "
                       "horizon delta.");
+    prm.declare_entry("Node order", "cells", Patterns::Selection("cells|lattice"),
+                      "Local numbering of the owned nodes: cells (the octree's "
+                      "space-filling curve, lattice order within a cell) or lattice "
+                      "(by lattice index, x fastest). The same nodes, bonds and "
+                      "results; lattice order makes the hybrid model's copies into "
+                      "its lattice box long contiguous runs.");
   }
 
   void
@@ -61,6 +67,7 @@ namespace PeriDEAL
     layer_thickness = prm.get_double("Volume constraint layer");
     if (layer_thickness < 0.)
       layer_thickness = delta;
+    lattice_order = (prm.get("Node order") == "lattice");
   }
 
   std::size_t
@@ -411,7 +418,8 @@ namespace PeriDEAL
     };
 
     // Owned nodes in cell order (the octree's space-filling curve), and in
-    // lattice order within a cell: neighbours end up close in memory.
+    // lattice order within a cell: neighbours end up close in memory. Or, with
+    // LatticeParameters::lattice_order, all owned nodes by lattice index.
     n_owned_nodes = particle_handler->n_locally_owned_particles();
     const types::global_dof_index offset = [&] {
       types::global_dof_index mine = n_owned_nodes, before = 0;
@@ -421,28 +429,38 @@ namespace PeriDEAL
     }();
     n_global_nodes = Utilities::MPI::sum<types::global_dof_index>(n_owned_nodes, mpi_communicator);
 
-    const double cell_volume = std::pow(lattice.dx, dim);
+    using ParticleIterator = typename Particles::ParticleHandler<dim>::particle_iterator;
+    std::vector<std::pair<ParticleIterator, unsigned int>> owned_nodes;
+    owned_nodes.reserve(n_owned_nodes);
     for (const auto &cell : triangulation->active_cell_iterators())
       {
         if (!cell->is_locally_owned())
           continue;
-        auto range = particle_handler->particles_in_cell(cell);
-        std::vector<typename Particles::ParticleHandler<dim>::particle_iterator> its;
+        const std::size_t first = owned_nodes.size();
+        auto              range = particle_handler->particles_in_cell(cell);
         for (auto p = range.begin(); p != range.end(); ++p)
-          its.push_back(p);
-        std::sort(its.begin(), its.end(),
-                  [](const auto &a, const auto &b) { return a->get_id() < b->get_id(); });
-        for (auto &p : its)
-          {
-            const unsigned int local = position.size();
-            nodes_in_cell[cell->active_cell_index()].push_back(local);
-            position.push_back(p->get_location());
-            volume.push_back(cell_volume);
-            id.push_back(p->get_id());
-            region.push_back((unsigned char)(p->get_properties()[1]));
-            lattice_index.push_back(lattice_of(p->get_id()));
-            p->get_properties()[0] = double(offset + local);
-          }
+          owned_nodes.emplace_back(p, cell->active_cell_index());
+        std::sort(owned_nodes.begin() + first, owned_nodes.end(),
+                  [](const auto &a, const auto &b) { return a.first->get_id() < b.first->get_id(); });
+      }
+    if (lattice.lattice_order)
+      std::sort(owned_nodes.begin(), owned_nodes.end(),
+                [](const auto &a, const auto &b) { return a.first->get_id() < b.first->get_id(); });
+
+    const double cell_volume = std::pow(lattice.dx, dim);
+    cell_of_owned_node.clear();
+    cell_of_owned_node.reserve(n_owned_nodes);
+    for (auto &[p, cell_index] : owned_nodes)
+      {
+        const unsigned int local = position.size();
+        nodes_in_cell[cell_index].push_back(local);
+        cell_of_owned_node.push_back(cell_index);
+        position.push_back(p->get_location());
+        volume.push_back(cell_volume);
+        id.push_back(p->get_id());
+        region.push_back((unsigned char)(p->get_properties()[1]));
+        lattice_index.push_back(lattice_of(p->get_id()));
+        p->get_properties()[0] = double(offset + local);
       }
     AssertThrow(position.size() == n_owned_nodes, ExcInternalError());
 
@@ -535,72 +553,72 @@ namespace PeriDEAL
     nb.table_start.reserve(n_owned_nodes);
     nb.col.reserve(std::size_t(n_owned_nodes) * nb.stencil_size);
 
-    std::vector<int>          slot(nb.stencil_size, -1);
-    std::vector<unsigned int> neighbor_cells;
-    unsigned int              row = 0;
+    // The cells around each owned cell (its own included), sorted.
+    std::vector<std::vector<unsigned int>> neighbor_cells_of(triangulation->n_active_cells());
     for (const auto &cell : triangulation->active_cell_iterators())
       {
-        if (!cell->is_locally_owned())
+        if (!cell->is_locally_owned() || nodes_in_cell[cell->active_cell_index()].empty())
           continue;
-        const auto &mine = nodes_in_cell[cell->active_cell_index()];
-        if (mine.empty())
-          continue;
-        neighbor_cells.clear();
+        auto &neighbor_cells = neighbor_cells_of[cell->active_cell_index()];
         for (const unsigned int v : cell->vertex_indices())
           for (const auto &nc : vertex_to_cells[cell->vertex_index(v)])
             neighbor_cells.push_back(nc->active_cell_index());
         std::sort(neighbor_cells.begin(), neighbor_cells.end());
         neighbor_cells.erase(std::unique(neighbor_cells.begin(), neighbor_cells.end()),
                              neighbor_cells.end());
+      }
 
-        for (const unsigned int i : mine)
+    // Rows in local order (by cells or by lattice index); a row's bonds are
+    // in stencil order either way.
+    std::vector<int> slot(nb.stencil_size, -1);
+    unsigned int     row = 0;
+    for (unsigned int i = 0; i < n_owned_nodes; ++i)
+      {
+        const auto  &neighbor_cells = neighbor_cells_of[cell_of_owned_node[i]];
+        const auto  &li             = lattice_index[i];
+        unsigned int n_found        = 0;
+        for (const unsigned int nc : neighbor_cells)
+          for (const unsigned int j : nodes_in_cell[nc])
+            {
+              const auto  &lj = lattice_index[j];
+              unsigned int b = 0, stride = 1;
+              bool         in_box = true;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  const int o = lj[d] - li[d];
+                  in_box      = in_box && (o >= -M && o <= M);
+                  b += (o + M) * stride;
+                  stride *= W;
+                }
+              if (!in_box)
+                continue;
+              const int s = slot_of_offset[b];
+              if (s >= 0)
+                {
+                  slot[s] = j;
+                  ++n_found;
+                }
+            }
+        if (n_found == nb.stencil_size)
           {
-            AssertThrow(i == row, ExcInternalError());
-            const auto  &li      = lattice_index[i];
-            unsigned int n_found = 0;
-            for (const unsigned int nc : neighbor_cells)
-              for (const unsigned int j : nodes_in_cell[nc])
-                {
-                  const auto &lj = lattice_index[j];
-                  unsigned int b = 0, stride = 1;
-                  bool         in_box = true;
-                  for (unsigned int d = 0; d < dim; ++d)
-                    {
-                      const int o = lj[d] - li[d];
-                      in_box      = in_box && (o >= -M && o <= M);
-                      b += (o + M) * stride;
-                      stride *= W;
-                    }
-                  if (!in_box)
-                    continue;
-                  const int s = slot_of_offset[b];
-                  if (s >= 0)
-                    {
-                      slot[s] = j;
-                      ++n_found;
-                    }
-                }
-            if (n_found == nb.stencil_size)
-              {
-                nb.table_start.push_back(0);
-                ++nb.n_regular_rows;
-              }
-            else
-              nb.table_start.push_back(nb.bond_length.size());
-            for (unsigned int s = 0; s < nb.stencil_size; ++s)
-              if (slot[s] >= 0)
-                {
-                  nb.col.push_back(slot[s]);
-                  if (n_found != nb.stencil_size)
-                    {
-                      nb.bond_length.push_back(nb.bond_length[s]);
-                      nb.bond_weight.push_back(nb.bond_weight[s]);
-                    }
-                  slot[s] = -1;
-                }
-            nb.row_start.push_back(nb.col.size());
-            ++row;
+            nb.table_start.push_back(0);
+            ++nb.n_regular_rows;
           }
+        else
+          nb.table_start.push_back(nb.bond_length.size());
+        for (unsigned int s = 0; s < nb.stencil_size; ++s)
+          if (slot[s] >= 0)
+            {
+              nb.col.push_back(slot[s]);
+              if (n_found != nb.stencil_size)
+                {
+                  nb.bond_length.push_back(nb.bond_length[s]);
+                  nb.bond_weight.push_back(nb.bond_weight[s]);
+                }
+              slot[s] = -1;
+            }
+        nb.row_start.push_back(nb.col.size());
+        ++row;
       }
     AssertThrow(row == n_owned_nodes, ExcInternalError());
     nb.col.shrink_to_fit();

@@ -151,6 +151,23 @@ namespace PeriDEAL
     store_lane_forces(VectorField &force, const std::int32_t *node, const std::size_t L0,
                       const unsigned int lanes, const __m512d *value)
     {
+      // Eight consecutive nodes (box rows numbered in lattice order,
+      // LatticeParameters::lattice_order): one masked store per dimension,
+      // the same values at the same nodes. Aligned L0 only: node has
+      // whole vectors of eight positions (unaligned Omega_s runs may end
+      // at its last entry).
+      const std::int32_t n0 = node[L0];
+      if (L0 % 8 == 0 && n0 >= 0)
+        {
+          const __m256i nodes = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(node + L0));
+          const __m256i run   = _mm256_add_epi32(_mm256_set1_epi32(n0), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+          if (_mm256_cmpeq_epi32_mask(nodes, run) == 0xff)
+            {
+              for (unsigned int d = 0; d < dim; ++d)
+                _mm512_mask_storeu_pd(force[d].begin() + n0, __mmask8(lanes), value[d]);
+              return;
+            }
+        }
       alignas(64) double out[dim][8];
       for (unsigned int d = 0; d < dim; ++d)
         _mm512_store_pd(out[d], value[d]);

@@ -21,6 +21,8 @@
 //             per-offset masked kernel (the same exact node tests too);
 //  row_test:  the same with the grouped kernel's loads shared along the
 //             stencil rows (row_shared_test);
+//  lattice_order: nodes numbered by lattice index = numbered by cells
+//             (bit for bit, 1 or 2 ranks);
 //  half_stencil: the half-stencil Omega_s sweep = the full-stencil rows
 //             (broken bonds, switching, damage; forces to round-off);
 //  initial_fraction: the initial Omega_s (pre-cracks and boundaries) at the
@@ -717,16 +719,16 @@ namespace
    * b).
    */
   std::pair<std::uint64_t, std::uint64_t>
-  check_kw_same(const std::function<void(HybridMechanicsParameters &)> &a,
-                const std::function<void(HybridMechanicsParameters &)> &b,
-                const std::string &reference, const std::string &dir)
+  check_kw_same_run(const std::function<void(MechanicsRunParameters<2> &)> &a,
+                    const std::function<void(MechanicsRunParameters<2> &)> &b,
+                    const std::string &reference, const std::string &dir)
   {
     const double dx = 1., delta = 4., T = 87.5e-6;
     auto         pf = kalthoff_winkler(dx, delta, T, "hybrid adaptive", 0.8, dir);
     auto         pe = pf;
     pe.output_directory = dir + "-reference";
-    a(pf.hybrid);
-    b(pe.hybrid);
+    a(pf);
+    b(pe);
     MechanicsSolver<2> fast(MPI_COMM_WORLD, pf), every(MPI_COMM_WORLD, pe);
     fast.run();
     every.run();
@@ -803,6 +805,16 @@ namespace
     return {tests_fast, tests_every};
   }
 
+  /** check_kw_same_run() with variants of the hybrid's parameters only. */
+  std::pair<std::uint64_t, std::uint64_t>
+  check_kw_same(const std::function<void(HybridMechanicsParameters &)> &a,
+                const std::function<void(HybridMechanicsParameters &)> &b,
+                const std::string &reference, const std::string &dir)
+  {
+    return check_kw_same_run([&](MechanicsRunParameters<2> &p) { a(p.hybrid); },
+                             [&](MechanicsRunParameters<2> &p) { b(p.hybrid); }, reference, dir);
+  }
+
   // (h) The fast switching test (lattice bound, p formed only where read)
   // against the exact test of every bond at every step, on KW at CI size
   // on 1 or 2 ranks (check_kw_same()).
@@ -875,6 +887,42 @@ namespace
             (hm->uses_lattice_sweep() ? "yes" : "no") + ")");
   }
 
+  // (h4) Nodes numbered by lattice index (LatticeParameters::lattice_order,
+  // the hybrid run of kw_hybrid_benchmark) against the default numbering by
+  // cells, on KW at CI size on 1 or 2 ranks: the same nodes per rank and
+  // the same arithmetic in every sweep, so bit for bit the same switches,
+  // damage and displacements, and the same exact node tests. The numbering
+  // must differ (else the test checks nothing), and on one rank the owned
+  // nodes must be in lattice order.
+  void
+  lattice_order()
+  {
+    const auto [tests_lattice, tests_cells] = check_kw_same_run(
+      [](MechanicsRunParameters<2> &p) { p.lattice.lattice_order = true; },
+      [](MechanicsRunParameters<2> &p) { p.lattice.lattice_order = false; },
+      "the nodes numbered by cells", "kw-lattice-order");
+    check(tests_lattice == tests_cells && tests_lattice > 0,
+          "the same exact node tests: " + std::to_string(tests_lattice) + " / " +
+            std::to_string(tests_cells));
+    auto p = kalthoff_winkler(1., 4., 87.5e-6, "hybrid adaptive", 0.8, "kw-lattice-order-setup");
+    Discretization<2> by_cells(MPI_COMM_WORLD), by_lattice(MPI_COMM_WORLD);
+    by_cells.setup(*p.domain, p.lattice);
+    p.lattice.lattice_order = true;
+    by_lattice.setup(*p.domain, p.lattice);
+    unsigned int moved = 0, unsorted = 0;
+    for (unsigned int i = 0; i < by_lattice.n_owned(); ++i)
+      {
+        moved += by_lattice.id[i] != by_cells.id[i];
+        unsorted += i > 0 && by_lattice.id[i] <= by_lattice.id[i - 1];
+      }
+    moved    = Utilities::MPI::sum(moved, MPI_COMM_WORLD);
+    unsorted = Utilities::MPI::sum(unsorted, MPI_COMM_WORLD);
+    check(moved > 0 && unsorted == 0 &&
+            by_lattice.neighborhood.n_bonds() == by_cells.neighborhood.n_bonds(),
+          std::to_string(moved) + " nodes numbered otherwise than by cells, owned ids increasing (" +
+            std::to_string(unsorted) + " not), the same bonds");
+  }
+
   // (f) Initial Omega_s of the KW plate (driver defaults: nodes within one
   // horizon of the boundary or two of a pre-crack). Its area is a band
   // whose width is proportional to delta, so the fraction depends on delta,
@@ -920,5 +968,6 @@ main(int argc, char **argv)
               {"grouped_test", grouped_test},
               {"row_test", row_test},
               {"half_stencil", half_stencil},
+              {"lattice_order", lattice_order},
               {"stretch_budget", StretchBudgetTest::stretch_budget}});
 }

@@ -3,7 +3,7 @@
 # scheme, rank invariance, bad input, initial Omega_s vs Table 3.3 (one
 # executable).
 perideal_add_test_program(hybrid_kw_tests ${CMAKE_CURRENT_LIST_DIR}/hybrid_kw_tests.cc)
-foreach(_t patch kw bad_input stretch_budget sweep initial_fraction kw_classes kw_lattice kw_equivalence grouped_test row_test half_stencil)
+foreach(_t patch kw bad_input stretch_budget sweep initial_fraction kw_classes kw_lattice kw_equivalence grouped_test row_test half_stencil lattice_order)
   perideal_add_test(NAME hybrid_kw.${_t} COMMAND $<TARGET_FILE:hybrid_kw_tests> ${_t} LABELS unit)
 endforeach()
 perideal_add_test(NAME hybrid_kw.rank_invariance.np2 NPROCS 2
@@ -18,3 +18,5 @@ perideal_add_test(NAME hybrid_kw.sweep.np2 NPROCS 2
   COMMAND $<TARGET_FILE:hybrid_kw_tests> sweep LABELS "unit;mpi")
 perideal_add_test(NAME hybrid_kw.half_stencil.np2 NPROCS 2
   COMMAND $<TARGET_FILE:hybrid_kw_tests> half_stencil LABELS "unit;mpi")
+perideal_add_test(NAME hybrid_kw.lattice_order.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:hybrid_kw_tests> lattice_order LABELS "unit;mpi")

@@ -46,6 +46,16 @@ namespace PeriDEAL
      * Layer nodes carry region 1 and prescribed (Dirichlet) values.
      */
     double layer_thickness = 0.;
+    /**
+     * Local numbering of the owned nodes: false (default) by cells (the
+     * octree's space-filling curve, lattice order within a cell), true by
+     * lattice index (x fastest). The same nodes, bonds and partition; only
+     * the local (and global) indices differ. In lattice order the owned
+     * nodes of a dense rectangular part are consecutive along lattice rows,
+     * so that copies between node vectors and a lattice box (the hybrid
+     * model's sweeps) are a few long runs instead of one run per cell row.
+     */
+    bool lattice_order = false;
 
     /** Declare the "Discretization" entries. */
     static void
@@ -259,6 +269,8 @@ namespace PeriDEAL
 
     /** Local node lists per active cell (by active cell index). */
     std::vector<std::vector<unsigned int>> nodes_in_cell;
+    /** Active cell index of each owned node. */
+    std::vector<unsigned int> cell_of_owned_node;
   };
 } // namespace PeriDEAL
 
