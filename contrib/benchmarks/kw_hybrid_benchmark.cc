@@ -8,6 +8,7 @@
 //                       [--interval 1] [--every-step 0] [--bound lattice|budget]
 //                       [--chunk 16] [--half-stencil 0|1] [--grouped-test 0|1]
 //                       [--row-test 0|1] [--node-order lattice|cells]
+//                       [--standard-node-order lattice|cells]
 //                       [--directory kw-hybrid-benchmark]
 //
 // Timing: the machine may be shared, so the two runs advance in turns, in
@@ -26,12 +27,17 @@
 // on; the same q bit for bit); --row-test 0 the grouped kernel's per-offset
 // loads instead of one load per stencil row (row_shared_test, default on;
 // the same q bit for bit). --node-order cells numbers the hybrid run's nodes
-// by cells, as the standard run's (LatticeParameters::lattice_order; the
-// default lattice numbers them by lattice rows, so that its per-step copy
-// of u into the lattice box is one run per dimension; the same results).
-// The keys kw_hybrid_state_hash_* are FNV-1a hashes of the final
-// displacement and damage bits of each run, node by node in the standard
-// run's (cell) order for both runs.
+// by cells (LatticeParameters::lattice_order; the default lattice numbers
+// them by lattice rows, so that its per-step copy of u into the lattice box
+// is one run per dimension; the same results). --standard-node-order does
+// the same for the standard run (default lattice: both runs in the same
+// order, so that the numbering favours neither). The keys
+// kw_hybrid_state_hash_* are FNV-1a hashes of the final displacement and
+// damage bits of each run, node by node in the standard run's order for
+// both runs; kw_hybrid_state_hash_by_id_* the same in particle id order,
+// which does not depend on either numbering (with both runs in lattice
+// order the two pairs coincide; --standard-node-order cells gives the
+// hashes of sessions 13-16, b41a2c30deaaae34 / 06b8976784912402).
 //
 // The plate is that of tutorial/step-4 (100 x 200 mm, pre-cracks of 50 mm
 // at y = +-25). The source uses dx = 0.25 mm, delta = 2 mm (m = 8) and
@@ -126,7 +132,8 @@ main(int argc, char **argv)
   double      dx = 0.25, m = 8., end_time = 87.5e-6, sigma = 0.95;
   int         interval = 1, every_step = 0, chunk = 16, half_stencil = -1, grouped_test = -1,
               row_test = -1;
-  std::string dir = "kw-hybrid-benchmark", bound = "lattice", node_order = "lattice";
+  std::string dir = "kw-hybrid-benchmark", bound = "lattice", node_order = "lattice",
+              standard_node_order = "lattice";
   for (int a = 1; a + 1 < argc; a += 2)
     {
       const std::string key = argv[a], value = argv[a + 1];
@@ -152,6 +159,8 @@ main(int argc, char **argv)
         row_test = std::stoi(value);
       else if (key == "--node-order" && (value == "lattice" || value == "cells"))
         node_order = value;
+      else if (key == "--standard-node-order" && (value == "lattice" || value == "cells"))
+        standard_node_order = value;
       else if (key == "--chunk")
         chunk = std::max(1, std::stoi(value));
       else if (key == "--directory")
@@ -186,6 +195,7 @@ main(int argc, char **argv)
   const double initial      = hybrid.hybrid_model()->standard_fraction();
   auto ps = kalthoff_winkler(dx, delta, end_time, "standard", sigma, dir + "/standard", 100000000);
   ps.time_step = hybrid.integrator().time_step();
+  ps.lattice.lattice_order = standard_node_order == "lattice";
   t0           = cpu_seconds();
   MechanicsSolver<2> standard(MPI_COMM_WORLD, ps);
   standard.setup();
@@ -234,6 +244,14 @@ main(int argc, char **argv)
   std::vector<unsigned int> s_order(ds.size());
   for (unsigned int i = 0; i < s_order.size(); ++i)
     s_order[i] = i;
+  // The same hashes node by node in particle id order: independent of both
+  // runs' numbering (cell or lattice order).
+  std::vector<unsigned int> s_by_id = s_order, h_by_id(ds.size());
+  std::sort(s_by_id.begin(), s_by_id.end(), [&](const unsigned int a, const unsigned int b) {
+    return standard.discretization().id[a] < standard.discretization().id[b];
+  });
+  for (unsigned int k = 0; k < s_by_id.size(); ++k)
+    h_by_id[k] = h_of[s_by_id[k]];
   const auto          &x  = standard.discretization().position;
   double               max_diff = 0.;
   std::vector<unsigned int> cracked[2];
@@ -302,6 +320,7 @@ main(int argc, char **argv)
   std::cout << std::setprecision(6) << "kw_hybrid_nodes: " << standard.discretization().n_global()
             << "\nkw_hybrid_m: " << m << "\nkw_hybrid_steps: " << hybrid.integrator().step()
             << "\nkw_hybrid_node_order: " << node_order
+            << "\nkw_hybrid_standard_node_order: " << standard_node_order
             << "\nkw_hybrid_load_average: " << load[0]
             << "\nkw_hybrid_standard_seconds: " << ts << "\nkw_hybrid_adaptive_seconds: " << th
             << "\nkw_hybrid_initial_standard_percent: " << 100. * initial
@@ -322,7 +341,9 @@ main(int argc, char **argv)
             << "\nkw_hybrid_speedup_median_chunk: " << median_ratio
             << std::hex << std::setfill('0') << "\nkw_hybrid_state_hash_standard: " << std::setw(16)
             << state_hash(standard, ds, s_order) << "\nkw_hybrid_state_hash_adaptive: " << std::setw(16)
-            << state_hash(hybrid, dh, h_of) << std::dec << std::setfill(' ')
+            << state_hash(hybrid, dh, h_of) << "\nkw_hybrid_state_hash_by_id_standard: " << std::setw(16)
+            << state_hash(standard, ds, s_by_id) << "\nkw_hybrid_state_hash_by_id_adaptive: " << std::setw(16)
+            << state_hash(hybrid, dh, h_by_id) << std::dec << std::setfill(' ')
             << "\nkw_speedup_hybrid_adaptive_over_standard: " << ts / th << std::endl;
   return 0;
 }
