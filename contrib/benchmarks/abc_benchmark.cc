@@ -28,6 +28,8 @@
 #include <perideal/abc/pd_unbounded_diffusion.h>
 #include <perideal/fem/fem_diffusion.h>
 
+#include "wave_settings.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -207,19 +209,10 @@ main(int argc, char **argv)
   Abc::WaveAbcParameters plane;
   plane.cone_angle             = 0.5;
   plane.share_updating_vectors = share;
-  // The long-run monotone layer adopted for E14 in session 15
-  // (e14_monotone_parameters() of tests/wave_abc): discrete relation, curved
-  // normal modes rho = R, increment form, clouds of 4 dx (16-20 points per
-  // dot product instead of 5-8), Delta phi 0.4, Tikhonov 4e-4.
-  Abc::WaveAbcParameters monotone = plane;
-  monotone.dispersion                    = "discrete";
-  monotone.n_directions                  = 0;
-  monotone.curvature_radius              = R;
-  monotone.cloud_radius                  = 1.;
-  monotone.cone_angle                    = 0.4;
-  monotone.pseudo_inverse_tolerance      = 4e-4;
-  monotone.pseudo_inverse_regularization = "tikhonov";
-  monotone.fit_form                      = "increment";
+  // The long-run monotone layer adopted for E14 in session 15: clouds of
+  // 4 dx, 16-20 points per dot product instead of 5-8.
+  Abc::WaveAbcParameters monotone = PeriDEALTests::e14_monotone_parameters(R);
+  monotone.share_updating_vectors = share;
   for (const auto &[suffix, ap] : {std::pair{std::string(""), plane}, std::pair{std::string("_monotone"), monotone}})
     {
       const WaveOverhead wave2 = pd_wave_fraction(R, steps, ap);

@@ -104,16 +104,10 @@ namespace PeriDEAL
                         "2D: radius rho of the outgoing wave fronts at the boundary (0: plane modes, the "
                         "source); rho > 0: modes in polar coordinates about x_i - rho n with the "
                         "cylindrical amplitude sqrt(rho/r) (e.g. a disk near field centred at the source).");
-      prm.declare_entry("Wake modes", "none", Patterns::Anything(),
-                        "Non-oscillatory polynomial solutions added to the mode set: none (the source), "
-                        "linear (s, y, T(t)), quadratic (also s T, y T, s y, s^2 - y^2, s^2 + Q(t)) or a "
-                        "comma list of s, y, T, sT, yT, sy, ss-yy, ss+Q.");
       prm.declare_entry("Wake curvature radius", "0", Patterns::Double(0.),
                         "2D: curvature radius of the harmonic modes with |k| <= Wake wave number (0: Curvature radius for all).");
       prm.declare_entry("Wake wave number", "0", Patterns::Double(0.),
                         "Largest |k| of the modes that get the Wake curvature radius.");
-      prm.declare_entry("Wake mode weight", "1", Patterns::Double(0.),
-                        "Column weight of the wake modes in the least-squares fit over the modes (> 0).");
       prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge|pml"),
                         "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), "
                         "only the damping sponge (PD: nothing overwritten, energy-stable), or the "
@@ -166,8 +160,6 @@ namespace PeriDEAL
       layer_filter             = prm.get_double("Layer filter");
       fit_form                 = prm.get("Fit form");
       curvature_radius         = prm.get_double("Curvature radius");
-      wake_modes               = prm.get("Wake modes");
-      wake_mode_weight         = prm.get_double("Wake mode weight");
       wake_curvature_radius    = prm.get_double("Wake curvature radius");
       wake_wave_number         = prm.get_double("Wake wave number");
       method                   = prm.get("Method");
@@ -410,29 +402,6 @@ namespace PeriDEAL
           phi.push_back(prm.direction_range * (-1. + 2. * l / prm.n_directions));
       const unsigned int n_modes = k.size() * phi.size();
       stats.n_modes              = n_modes;
-      // Wake modes (kinds of the polynomial solutions, see the lambda wake below).
-      check_parameter(prm.wake_mode_weight > 0., "Absorbing boundary/Wake mode weight", prm.wake_mode_weight, "> 0");
-      std::vector<unsigned int> wake_kind;
-      {
-        // "linear", "quadratic" or a comma list of the names below.
-        const std::vector<std::string> names{"s", "y", "T", "sT", "yT", "sy", "ss-yy", "ss+Q"};
-        std::string list = prm.wake_modes == "none"   ? "" :
-                           prm.wake_modes == "linear" ? "s,y,T" :
-                           prm.wake_modes == "quadratic" ? "s,y,T,sT,yT,sy,ss-yy,ss+Q" :
-                                                          prm.wake_modes;
-        std::istringstream in(list);
-        std::string        item;
-        while (std::getline(in, item, ','))
-          {
-            const auto it = std::find(names.begin(), names.end(), item);
-            check_parameter(it != names.end(), "Absorbing boundary/Wake modes", prm.wake_modes,
-                            "none, linear, quadratic or a comma list of s, y, T, sT, yT, sy, ss-yy, ss+Q");
-            const unsigned int q = it - names.begin();
-            // 1D: no tangential coordinate.
-            if (dim == 2 || (q != 1 && q != 4 && q != 5 && q != 6))
-              wake_kind.push_back(q);
-          }
-      }
       // Zone-boundary wave vectors of the near-field lattice (global frame):
       // corner (pi/dx, ..., pi/dx) and the face centres (pi/dx e_d).
       std::vector<Tensor<1, dim>> lattice_wave_vectors;
@@ -560,38 +529,6 @@ namespace PeriDEAL
           const auto mode_rate = [&](const unsigned int c) {
             return -decay[c] - std::complex<double>(0., 1.) * omega[c];
           };
-          // Wake modes (after the n_all harmonic and lattice ones): value and
-          // time derivative of the polynomial solutions in the Cartesian
-          // local frame x bar = (s, y).
-          const double dw = dispersion.damping;
-          const auto   wake = [&](const Tensor<1, dim> &xbar, const double time, const unsigned int q) {
-            // T'' + 2 d T' = 0, T(0) = 0, T'(0) = 1; Q'' + 2 d Q' = 2 chi^2, Q(0) = Q'(0) = 0.
-            const double T  = dw > 0. ? -std::expm1(-2. * dw * time) / (2. * dw) : time;
-            const double Tt = dw > 0. ? std::exp(-2. * dw * time) : 1.;
-            const double Q  = dw > 0. ? chi * chi * (time - T) / dw : chi * chi * time * time;
-            const double Qt = dw > 0. ? chi * chi * (1. - Tt) / dw : 2. * chi * chi * time;
-            const double x = xbar[0], y = dim == 2 ? xbar[dim - 1] : 0.;
-            switch (wake_kind[q])
-              {
-                case 0:
-                  return std::make_pair(x, 0.);
-                case 1:
-                  return std::make_pair(y, 0.);
-                case 2:
-                  return std::make_pair(T, Tt);
-                case 3:
-                  return std::make_pair(x * T, x * Tt);
-                case 4:
-                  return std::make_pair(y * T, y * Tt);
-                case 5:
-                  return std::make_pair(x * y, 0.);
-                case 6:
-                  return std::make_pair(x * x - y * y, 0.);
-                default:
-                  return std::make_pair(x * x + Q, Qt);
-              }
-          };
-          const unsigned int n_fit = n_all + wake_kind.size();
 
           // Candidates: x_i and the points of the cone within d_inf.
           std::vector<std::pair<unsigned int, Tensor<1, dim>>> cone;
@@ -758,8 +695,8 @@ namespace PeriDEAL
                 break;
               // Moment matrices (4.79): rows (x_j, t = 0) and (x_j, t = -dt)
               // (block means of the modes for averaged entries).
-              CMatrix MG(2 * cloud.size(), n_fit), MH(2 * cloud.size(), n_fit);
-              CRow    psi_g(n_fit), psi_h(n_fit);
+              CMatrix MG(2 * cloud.size(), n_all), MH(2 * cloud.size(), n_all);
+              CRow    psi_g(n_all), psi_h(n_all);
               for (unsigned int c = 0; c < n_all; ++c)
                 {
                   psi_g[c] = mode(Tensor<1, dim>(), dt, c);
@@ -780,30 +717,6 @@ namespace PeriDEAL
                             value += q.second * mode(cone[q.first].second, -double(s) * dt, c);
                         MG(2 * j + s, c) = value;
                         MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
-                      }
-                }
-              // Wake columns, scaled by their weight (value and rate separately:
-              // the polynomials are not exponential in time).
-              for (unsigned int q = 0; q < wake_kind.size(); ++q)
-                {
-                  const unsigned int c  = n_all + q;
-                  const double       ww = prm.wake_mode_weight;
-                  const auto         at = wake(Tensor<1, dim>(), dt, q), at0 = wake(Tensor<1, dim>(), 0., q);
-                  psi_g[c] = ww * (at.first - (increment ? at0.first : 0.));
-                  psi_h[c] = ww * (at.second - (increment ? at0.second : 0.));
-                  for (unsigned int j = 0; j < cloud.size(); ++j)
-                    for (unsigned int s = 0; s < 2; ++s)
-                      {
-                        double value = 0., rate = 0.;
-                        if (s < prm.n_time_levels)
-                          for (const auto &m : members[j])
-                            {
-                              const auto w = wake(cone[m.first].second, -double(s) * dt, q);
-                              value += m.second * w.first;
-                              rate += m.second * w.second;
-                            }
-                        MG(2 * j + s, c) = ww * value;
-                        MH(2 * j + s, c) = ww * rate;
                       }
                 }
               fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);

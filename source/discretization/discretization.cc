@@ -571,7 +571,6 @@ namespace PeriDEAL
     // Rows in local order (by cells or by lattice index); a row's bonds are
     // in stencil order either way.
     std::vector<int> slot(nb.stencil_size, -1);
-    unsigned int     row = 0;
     for (unsigned int i = 0; i < n_owned_nodes; ++i)
       {
         const auto  &neighbor_cells = neighbor_cells_of[cell_of_owned_node[i]];
@@ -618,9 +617,7 @@ namespace PeriDEAL
               slot[s] = -1;
             }
         nb.row_start.push_back(nb.col.size());
-        ++row;
       }
-    AssertThrow(row == n_owned_nodes, ExcInternalError());
     nb.col.shrink_to_fit();
     nb.bond_length.shrink_to_fit();
     nb.bond_weight.shrink_to_fit();

@@ -409,10 +409,13 @@ namespace
   void
   bad_input()
   {
-    const auto throws = [](const unsigned int degree, const Fem::WaveBoundary bc) {
+    // True if the set-up of E13 (dt 0.01, changed by @p configure) on a small
+    // square with @p bc throws a ParameterError naming @p parameter.
+    const auto rejected = [](const std::function<void(E13 &)> &configure, const Fem::WaveBoundary bc,
+                             const std::string &parameter) {
       E13 c           = e13_default();
-      c.fem.degree    = degree;
       c.fem.time_step = 0.01;
+      configure(c);
       const ScalarFunctionFromFunctionObject<2> u0(pulse);
       Triangulation<2>                          tria;
       GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
@@ -422,73 +425,32 @@ namespace
         }
       catch (const ParameterError &e)
         {
-          return std::string(e.what()).find("FEM/Degree") != std::string::npos;
+          return std::string(e.what()).find(parameter) != std::string::npos;
         }
       return false;
     };
-    check(throws(2, Fem::WaveBoundary::absorbing), "Q2 + EBF rejected naming FEM/Degree");
-    check(!throws(2, Fem::WaveBoundary::first_order), "Q2 + first-order ABC accepted");
-    check(throws(3, Fem::WaveBoundary::dirichlet), "Q3 rejected naming FEM/Degree");
+    const auto degree = [](const unsigned int k) { return [k](E13 &c) { c.fem.degree = k; }; };
+    check(rejected(degree(2), Fem::WaveBoundary::absorbing, "FEM/Degree"), "Q2 + EBF rejected naming FEM/Degree");
+    check(!rejected(degree(2), Fem::WaveBoundary::first_order, "FEM/Degree"), "Q2 + first-order ABC accepted");
+    check(rejected(degree(3), Fem::WaveBoundary::dirichlet, "FEM/Degree"), "Q3 rejected naming FEM/Degree");
     // Consistent mass needs the implicit scheme; unknown schemes are named.
-    const auto rejects = [](const std::string &scheme, const bool lumped, const std::string &parameter) {
-      E13 c             = e13_default();
-      c.fem.time_step   = 0.01;
-      c.fem.scheme      = scheme;
-      c.fem.lumped_mass = lumped;
-      const ScalarFunctionFromFunctionObject<2> u0(pulse);
-      Triangulation<2>                          tria;
-      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
-      try
-        {
-          Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::dirichlet, c.abc, u0);
-        }
-      catch (const ParameterError &e)
-        {
-          return std::string(e.what()).find(parameter) != std::string::npos;
-        }
-      return false;
+    const auto scheme = [](const std::string &name, const bool lumped) {
+      return [name, lumped](E13 &c) {
+        c.fem.scheme      = name;
+        c.fem.lumped_mass = lumped;
+      };
     };
-    check(rejects("velocity Verlet", false, "FEM/Lumped mass"), "consistent mass + Verlet rejected naming FEM/Lumped mass");
-    check(rejects("leapfrog", true, "FEM/Scheme"), "unknown scheme rejected naming FEM/Scheme");
-    // Curved modes need the centre x_i - rho n outside the cloud.
-    bool named = false;
-    try
-      {
-        E13 c                  = e13_default();
-        c.fem.time_step        = 0.01;
-        c.abc.curvature_radius = 0.5; // < the default cloud radius 2 h = 1
-        const ScalarFunctionFromFunctionObject<2> u0(pulse);
-        Triangulation<2>                          tria;
-        GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
-        Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
-      }
-    catch (const ParameterError &e)
-      {
-        named = std::string(e.what()).find("Curvature radius") != std::string::npos;
-      }
-    check(named, "Curvature radius below the cloud radius rejected naming Absorbing boundary/Curvature radius");
-    // Session 17 options: an unknown wake mode, a wake radius inside the cloud.
-    const auto wake_rejected = [](const std::string &modes, const double radius, const std::string &parameter) {
-      E13 c                       = e13_default();
-      c.fem.time_step             = 0.01;
-      c.abc.wake_modes            = modes;
-      c.abc.wake_curvature_radius = radius;
-      const ScalarFunctionFromFunctionObject<2> u0(pulse);
-      Triangulation<2>                          tria;
-      GridGenerator::subdivided_hyper_cube(tria, 4, -1., 1.);
-      try
-        {
-          Fem::FemWave<2> w(tria, c.fem, Fem::WaveBoundary::absorbing, c.abc, u0);
-        }
-      catch (const ParameterError &e)
-        {
-          return std::string(e.what()).find(parameter) != std::string::npos;
-        }
-      return false;
-    };
-    check(wake_rejected("s,bogus", 0., "Wake modes"), "unknown wake mode rejected naming Absorbing boundary/Wake modes");
-    check(!wake_rejected("linear", 0., "Wake modes"), "Wake modes = linear accepted");
-    check(wake_rejected("none", 0.5, "Wake curvature radius"),
+    check(rejected(scheme("velocity Verlet", false), Fem::WaveBoundary::dirichlet, "FEM/Lumped mass"),
+          "consistent mass + Verlet rejected naming FEM/Lumped mass");
+    check(rejected(scheme("leapfrog", true), Fem::WaveBoundary::dirichlet, "FEM/Scheme"),
+          "unknown scheme rejected naming FEM/Scheme");
+    // Curved modes need the centre x_i - rho n outside the cloud (the
+    // default cloud radius 2 h = 1).
+    check(rejected([](E13 &c) { c.abc.curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing, "Curvature radius"),
+          "Curvature radius below the cloud radius rejected naming Absorbing boundary/Curvature radius");
+    // The wake curvature radius (session 17) needs its centre outside the cloud too.
+    check(rejected([](E13 &c) { c.abc.wake_curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing,
+                   "Wake curvature radius"),
           "Wake curvature radius below the cloud radius rejected naming Absorbing boundary/Wake curvature radius");
   }
   /**
@@ -783,11 +745,11 @@ namespace
     const E13Result r = run_e13(newmark_wake_curvature(), true);
     // Measured: energy 4.28e-4 vs 5.27e-3 (12.3x), probe 2.35e-4 vs
     // 7.13e-3 (30x), field at t_end 8.78e-4 vs 8.60e-3 (9.79x; the issue's
-    // 10x is NOT reached; without the wake radius 9.06e-4, 9.5x). The run
-    // is deterministic (same numbers on every run): the field factor is
-    // asserted 3 % below the measured one so that it shows the gain over
-    // the 9.5x without the option, energy and probe ~20 % below.
-    check_e13_ratios(r, "Newmark consistent, curved modes, wake curvature 28: ", 10., 25., 9.5);
+    // 10x is NOT reached; the same setting without the wake radius gives
+    // 9.06e-4, 9.49x). The field factor is asserted halfway between the two
+    // (9.65): the test fails if the wake radius stops acting, and leaves
+    // 1.4 % for round-off across platforms; energy and probe ~20 % below.
+    check_e13_ratios(r, "Newmark consistent, curved modes, wake curvature 28: ", 10., 25., 9.65);
   }
 
   void

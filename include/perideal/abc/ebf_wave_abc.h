@@ -142,21 +142,6 @@ namespace PeriDEAL
        */
       double curvature_radius = 0.;
       /**
-       * Non-oscillatory "wake" modes added to the harmonic mode set: "none"
-       * (the source), "linear" or "quadratic". They are exact polynomial
-       * solutions of u_tt + 2 d u_t = chi^2 Laplace u in the local frame
-       * (x bar = (s, y), T(t) = (1 - exp(-2 d t)) / (2 d), t for d = 0):
-       * linear: s, y (2D), T; quadratic adds s T, y T, s y, s^2 - y^2 and
-       * s^2 + Q(t) (Q'' + 2 d Q' = 2 chi^2, Q(0) = Q'(0) = 0). The outgoing
-       * harmonic modes span near k = 0 only functions of s - chi t, not the
-       * slowly varying 2D wake behind a front, whose u_t + chi u_s is not
-       * small (E13, doc/design.md, sessions 14 and 17). Their columns are
-       * scaled by wake_mode_weight in the least-squares fit over the modes.
-       */
-      std::string wake_modes = "none";
-      /** Column weight of the wake modes in the fit (> 0; the harmonic modes have weight 1). */
-      double wake_mode_weight = 1.;
-      /**
        * 2D: curvature radius of the harmonic modes with |k| <= wake_wave_number
        * (0, the default: curvature_radius for every mode). A smaller radius
        * for the long waves gives them the larger decay (u_t + chi u_s) / u
