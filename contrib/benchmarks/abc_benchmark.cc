@@ -25,10 +25,10 @@
 #include <deal.II/grid/grid_generator.h>
 
 #include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/abc/wave_abc_layers.h>
 #include <perideal/abc/pd_unbounded_diffusion.h>
 #include <perideal/fem/fem_diffusion.h>
 
-#include "wave_settings.h"
 
 #include <algorithm>
 #include <cmath>
@@ -211,7 +211,7 @@ main(int argc, char **argv)
   plane.share_updating_vectors = share;
   // The long-run monotone layer adopted for E14 in session 15: clouds of
   // 4 dx, 16-20 points per dot product instead of 5-8.
-  Abc::WaveAbcParameters monotone = PeriDEALTests::e14_monotone_parameters(R);
+  Abc::WaveAbcParameters monotone = Abc::WaveAbcLayers::curved_monotone(0.25, R);
   monotone.share_updating_vectors = share;
   for (const auto &[suffix, ap] : {std::pair{std::string(""), plane}, std::pair{std::string("_monotone"), monotone}})
     {
