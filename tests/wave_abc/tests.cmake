@@ -23,6 +23,9 @@ endforeach()
 foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
+# E14 at the source's size (R = 26, t = 40 and 50; 80 s CPU).
+perideal_add_test(NAME wave_abc.pd_2d_source_size COMMAND $<TARGET_FILE:wave_abc_tests> pd_2d_source_size
+  LABELS long TIMEOUT 1200)
 # Three layer settings over 1e6 steps each, one with the energy at every step.
 perideal_add_test(NAME wave_abc.pd_2d_stable_long COMMAND $<TARGET_FILE:wave_abc_tests> pd_2d_stable_long
   LABELS long TIMEOUT 2400)
