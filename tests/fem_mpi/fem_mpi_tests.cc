@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <sstream>
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <iomanip>
@@ -50,11 +51,18 @@ namespace
     }
   };
 
+  /** Pulse exp(-log 2 |x|^2 / w2) (half width sqrt(w2)). */
+  double
+  pulse_of_width(const Point<2> &p, const double w2)
+  {
+    return std::exp(-std::log(2.) * p.square() / w2);
+  }
+
   /** Pulse of E13: exp(-log 2 |x|^2 / 9). */
   double
   pulse(const Point<2> &p)
   {
-    return std::exp(-std::log(2.) * p.square() / 9.);
+    return pulse_of_width(p, 9.);
   }
 
   using MeshMaker = std::function<void(Triangulation<2> &)>;
@@ -215,6 +223,59 @@ namespace
     return [=](Triangulation<2> &t) {
       GridGenerator::hyper_ball(t, Point<2>(), R);
       t.refine_global(refinements);
+    };
+  }
+
+  /**
+   * Disk of radius R_out whose inner part is disk(R, refinements) vertex
+   * for vertex (session 18): the refined hyper_ball, flattened, merged with
+   * a ring mesh on its boundary vertices (the same angles on every ring,
+   * rings dr apart, dr adjusted so that R_out is a ring). With MappingQ1
+   * the reference then has the near field's cells, mass and stiffness rows
+   * inside r < R, so no interpolation or mesh difference enters a
+   * near-field vs reference comparison.
+   */
+  MeshMaker
+  disk_nested(const double R, const unsigned int refinements, const double R_out, const double dr)
+  {
+    return [=](Triangulation<2> &t) {
+      Triangulation<2> ball, flat, shell;
+      GridGenerator::hyper_ball(ball, Point<2>(), R);
+      ball.refine_global(refinements);
+      GridGenerator::flatten_triangulation(ball, flat);
+      std::map<unsigned int, Point<2>> on_boundary;
+      for (const auto &cell : flat.active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              on_boundary[cell->face(f)->vertex_index(v)] = cell->face(f)->vertex(v);
+      std::vector<Point<2>> ring;
+      for (const auto &iv : on_boundary)
+        ring.push_back(iv.second);
+      std::sort(ring.begin(), ring.end(), [](const Point<2> &a, const Point<2> &b) {
+        return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]);
+      });
+      const unsigned int    n = ring.size(), n_rings = static_cast<unsigned int>(std::ceil((R_out - R) / dr - 1e-9));
+      std::vector<Point<2>> vertices;
+      for (unsigned int k = 0; k <= n_rings; ++k)
+        for (const Point<2> &p : ring)
+          vertices.push_back(k == 0 ? p : Point<2>(p * ((R + k * (R_out - R) / n_rings) / p.norm())));
+      std::vector<CellData<2>> cells;
+      for (unsigned int k = 0; k < n_rings; ++k)
+        for (unsigned int j = 0; j < n; ++j)
+          {
+            // Local x radial, y along the angle: right-handed.
+            CellData<2> c;
+            c.vertices[0] = k * n + j;
+            c.vertices[1] = (k + 1) * n + j;
+            c.vertices[2] = k * n + (j + 1) % n;
+            c.vertices[3] = (k + 1) * n + (j + 1) % n;
+            cells.push_back(c);
+          }
+      shell.create_triangulation(vertices, cells, SubCellData());
+      GridGenerator::merge_triangulations(flat, shell, t, 1e-9);
+      check(t.n_vertices() == flat.n_vertices() + n * n_rings && t.n_active_cells() == flat.n_active_cells() + n * n_rings,
+            "nested disk: the near field's boundary vertices are shared with the ring mesh");
     };
   }
 
@@ -541,10 +602,26 @@ namespace
     bool clouds = false;
   };
 
+  /**
+   * The initial data of run_disk_wave (session 18; the defaults are
+   * fem_mpi.disk_wave's problem).
+   */
+  struct DiskWaveProblem
+  {
+    /** The pulse exp(-log 2 |x - c|^2 / w2). */
+    double width2 = 9.;
+    /**
+     * Zero the reference's initial data outside r = R (the data an ABC can
+     * represent: the near field's own data and nothing outside).
+     */
+    bool truncate_reference = false;
+  };
+
   DiskWaveResult
   run_disk_wave(const MeshMaker &near_mesh, const MeshMaker &far_mesh, const double R, const double T,
                 const Abc::WaveAbcParameters &ap, const bool newmark = false,
-                const DiskWaveDiagnostics &diag = DiskWaveDiagnostics())
+                const DiskWaveDiagnostics &diag = DiskWaveDiagnostics(),
+                const DiskWaveProblem &problem = DiskWaveProblem())
   {
     Fem::FemWaveParameters fp;
     fp.damping   = 0.0125;
@@ -555,12 +632,17 @@ namespace
         fp.lumped_mass = false;
       }
     const Point<2>                            c0 = diag.centre;
+    const double                              w2 = problem.width2;
     const ScalarFunctionFromFunctionObject<2> u0(
-      [c0](const Point<2> &p) { return pulse(Point<2>(p - c0)); });
+      [c0, w2](const Point<2> &p) { return pulse_of_width(Point<2>(p - c0), w2); });
+    const bool                                cut = problem.truncate_reference;
+    const ScalarFunctionFromFunctionObject<2> u0_ref([c0, w2, cut, R](const Point<2> &p) {
+      return cut && p.norm() > R * (1. + 1e-9) ? 0. : pulse_of_width(Point<2>(p - c0), w2);
+    });
     Triangulation<2>                          near, far;
     near_mesh(near);
     far_mesh(far);
-    Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0);
+    Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0_ref);
     Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, ap, u0);
     Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, ap, u0);
     const auto     &st = ebf.absorbing_boundary().statistics();
@@ -701,6 +783,59 @@ namespace
   }
 
   /**
+   * Difference of two extended-disk (Dirichlet) runs in the metrics of
+   * run_disk_wave (session 18): max over the 16 samples of
+   * |E_b - E_a|/E0_a over the cells with centre r < R - 0.5 (each on its
+   * own mesh), of |u_b - u_a| at the probe, and max |u_b - u_a| over the
+   * vertices of @p near_mesh at T. @p cut_a / @p cut_b: zero initial data
+   * outside r = R. This is the floor an ABC comparison against run a has
+   * when run b is what the ABC can at best reproduce.
+   */
+  std::array<double, 3>
+  run_disk_floor(const MeshMaker &near_mesh, const MeshMaker &mesh_a, const bool cut_a, const MeshMaker &mesh_b,
+                 const bool cut_b, const double R, const double T, const double w2)
+  {
+    Fem::FemWaveParameters fp;
+    fp.damping   = 0.0125;
+    fp.time_step = 0.02;
+    const auto data = [R, w2](const bool cut) {
+      return ScalarFunctionFromFunctionObject<2>(
+        [R, w2, cut](const Point<2> &p) { return cut && p.norm() > R * (1. + 1e-9) ? 0. : pulse_of_width(p, w2); });
+    };
+    const ScalarFunctionFromFunctionObject<2> u0_a = data(cut_a), u0_b = data(cut_b);
+    Triangulation<2>                          near, ta, tb;
+    near_mesh(near);
+    mesh_a(ta);
+    mesh_b(tb);
+    const Abc::WaveAbcParameters ap;
+    Fem::FemWave<2>              a(ta, fp, Fem::WaveBoundary::dirichlet, ap, u0_a);
+    Fem::FemWave<2>              b(tb, fp, Fem::WaveBoundary::dirichlet, ap, u0_b);
+    const auto                   inside  = [R](const Point<2> &p) { return p.norm() < R - 0.5; };
+    const double                 e0      = a.energy(inside);
+    const unsigned int           n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
+    const Point<2>               probe(0.625 * R, 0.3125 * R);
+    std::array<double, 3>        r{{0., 0., 0.}};
+    for (unsigned int s = 1; s <= n_steps; ++s)
+      {
+        a.advance();
+        b.advance();
+        if (s % (n_steps / 16) == 0)
+          {
+            r[0] = std::max(r[0], std::abs(b.energy(inside) - a.energy(inside)) / e0);
+            r[1] = std::max(r[1], std::abs(b.value_at(probe) - a.value_at(probe)));
+          }
+      }
+    for (const auto &cell : near.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        r[2] = std::max(r[2], std::abs(b.value_at(cell->vertex(v)) - a.value_at(cell->vertex(v))));
+    if (root())
+      std::cout << "  floor: " << ta.n_active_cells() << " vs " << tb.n_active_cells()
+                << " cells: max |E_b - E_a|/E0 " << sci(r[0]) << ", probe " << sci(r[1]) << ", field at T "
+                << sci(r[2]) << std::endl;
+    return r;
+  }
+
+  /**
    * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
    * velocity Verlet, local dispersion) against the extended disk of radius
    * 18 (nothing reflected there is back before t = 16) and the first-order
@@ -826,13 +961,43 @@ namespace
                     if (root())
                       std::cout << "  h = " << h << ", d_inf = " << ap.cloud_radius << std::endl;
                   }
+                // Session 18: the reference disk nested (nested=1, rings
+                // dr apart, out to R_ref + grow), the pulse width (w2), the
+                // reference's data zero outside R (cut=1).
+                const double dr = num("dr", 0.2), R_big = R_ref + num("grow", 0.);
+                const MeshMaker far_mesh =
+                  kv.count("nested") ? disk_nested(R, level, R_big, dr) :
+                                       disk(R_big, static_cast<unsigned int>(num("ref", level + 1)));
+                if (kv.count("floor"))
+                  {
+                    // floor=A,B: run b against run a; each of std (hyper_ball
+                    // R_ref, refinement level + 1), stdcut, nest, nestcut,
+                    // nestfine (dr / 2), nestbig (R_ref + 4).
+                    const std::string spec = kv.at("floor");
+                    const auto        comma = spec.find(',');
+                    const auto        named = [&](const std::string &n) {
+                      if (n.rfind("std", 0) == 0)
+                        return disk(R_ref, level + 1);
+                      if (n.rfind("nestfine", 0) == 0)
+                        return disk_nested(R, level, R_ref, 0.5 * dr);
+                      if (n.rfind("nestbig", 0) == 0)
+                        return disk_nested(R, level, R_ref + 4., dr);
+                      return disk_nested(R, level, R_ref, dr);
+                    };
+                    const std::string a = spec.substr(0, comma), b = spec.substr(comma + 1);
+                    const auto cut = [](const std::string &n) { return n.find("cut") != std::string::npos; };
+                    run_disk_floor(disk(R, level), named(a), cut(a), named(b), cut(b), R, T, num("w2", 9.));
+                    continue;
+                  }
+                DiskWaveProblem problem;
+                problem.width2             = num("w2", 9.);
+                problem.truncate_reference = kv.count("cut") > 0;
                 DiskWaveDiagnostics diag;
                 diag.centre = Point<2>(num("x0", 0.), num("y0", 0.));
                 diag.series = kv.count("series") > 0;
                 diag.where  = kv.count("where") > 0;
                 diag.clouds = kv.count("clouds") > 0;
-                const auto r = run_disk_wave(disk(R, level), disk(R_ref, static_cast<unsigned int>(num("ref", level + 1))),
-                                             R, T, ap, kv.count("newmark") > 0, diag);
+                const auto r = run_disk_wave(disk(R, level), far_mesh, R, T, ap, kv.count("newmark") > 0, diag, problem);
                 if (root())
                   std::cout << "  late energy error EBF " << sci(r.late_ebf) << std::endl;
               }
