@@ -587,6 +587,8 @@ namespace
     double f_ebf = 0., f_first = 0.;
     /** Largest |E(t) - E_ref(t)|/E0 over the samples of the second half of the run (EBF). */
     double late_ebf = 0.;
+    /** Smallest and largest cloud (points, x_i included) and largest thinning stride of the EBF. */
+    unsigned int min_cloud = 0, max_cloud = 0, max_stride = 0;
   };
 
   /** Diagnostics of run_disk_wave (exploratory scan only; the defaults are the test's run). */
@@ -674,10 +676,13 @@ namespace
           }
       }
     const auto inside = [R](const Point<2> &p) { return p.norm() < R - 0.5; };
+    DiskWaveResult     r;
     const double       e0      = ref.energy(inside);
+    r.min_cloud                = st.min_cloud_size;
+    r.max_cloud                = st.max_cloud_size;
+    r.max_stride               = st.max_stride;
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
     const Point<2>     probe(0.625 * R, 0.3125 * R);
-    DiskWaveResult     r;
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
         ref.advance();
@@ -893,6 +898,79 @@ namespace
     check(rho <= 1. + 1e-10, "disk EBF, curved modes: one-step spectral radius " + sci(rho - 1.) + " above 1 <= 1e-10");
   }
 
+  /**
+   * Session 18: the disk comparison of disk_wave made well posed (issue 4).
+   * disk_wave's pulse (half width 3) is still 7.2e-3 at r = R = 8, with zero
+   * velocity. The reference has the part outside R too, and half of that
+   * travels inward. The near field does not have it, so no ABC can
+   * reproduce it. Measured (design.md, session 18): that floor alone is
+   * 1.96e-3 in energy against the first-order ABC's 1.16e-2, i.e. above
+   * the 1.16e-3 a 10x needs, and the non-nested reference hyper_ball adds
+   * 3.7e-3 (its cells with centre r < 7.5 are not the near field's). Here
+   * the pulse has half width sqrt(3.2) (u0(R) = 1e-6, tail floor 1.6e-8 in
+   * energy), the reference is disk_nested (the near field's cells inside
+   * R; rings 0.2 apart to R_ref, dr / 2: 2.6e-5 in energy), and every
+   * cloud is x_i + 2 points along the normal (d_inf = 0.4137 = 2.05 h; the
+   * default 2 h mixes x_i + 1 and x_i + 2, session 17).
+   */
+  void
+  disk_wave_compact()
+  {
+    const double           R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    Abc::WaveAbcParameters ap = e13_abc("local");
+    ap.curvature_radius       = R;
+    ap.n_directions           = 0;
+    ap.cloud_radius           = 0.4137;
+    DiskWaveProblem problem;
+    problem.width2 = 3.2;
+    // The data an ABC cannot represent: u0 at the boundary, ~1e-6.
+    check(pulse_of_width(Point<2>(R, 0.), problem.width2) < 1.1e-6, "compact pulse: u0(R) < 1.1e-6");
+    const auto r = run_disk_wave(disk(R, 5), disk_nested(R, 5, R_ref, 0.2), R, T, ap, false, DiskWaveDiagnostics(),
+                                 problem);
+    // The premise: x_i + 2 points in every cloud, none thinned.
+    check(r.min_cloud == 3 && r.max_cloud == 3 && r.max_stride == 1,
+          "compact disk: every cloud x_i + 2 points along the normal, stride 1");
+    // Measured: energy 1.117e-4 vs first order 3.550e-3 (31.8x), probe
+    // 1.253e-3 vs 1.589e-2 (12.7x), field at T 1.763e-3 vs 4.715e-2
+    // (26.7x). The 10x is the issue's. The absolute bounds are ~30 % above
+    // the measured values: the run is deterministic, so the margin only
+    // covers compilers and BLAS, and it is far below the default clouds'
+    // 1.21e-3 / 9.9e-3 / 1.39e-2 on this problem.
+    check(r.e_ebf < 1.5e-4 && 10. * r.e_ebf < r.e_first,
+          "compact disk EBF: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 1.5e-4 and 10x below first order (" +
+            sci(r.e_first) + ")");
+    check(r.p_ebf < 1.6e-3 && 10. * r.p_ebf < r.p_first,
+          "compact disk EBF: probe " + sci(r.p_ebf) + " < 1.6e-3 and 10x below first order (" + sci(r.p_first) + ")");
+    check(r.f_ebf < 2.3e-3 && 10. * r.f_ebf < r.f_first,
+          "compact disk EBF: field at t = T " + sci(r.f_ebf) + " < 2.3e-3 and 10x below first order (" +
+            sci(r.f_first) + ")");
+    // Stability: the one-step map on disk(2, 3) (the same boundary spacing)
+    // with clouds of the same kind (d_inf 0.40 there gives x_i + 2 in every
+    // cloud; 0.4137 thins some to x_i + 1 at stride 2: 1 + 4.4e-4). Measured
+    // 1 + 1.2e-14 (0 eigenvalues above 1 + 1e-8); disk(4, 4), rho 4, d_inf
+    // 0.4137 (every cloud x_i + 2): 1 + 0 (design.md, session 18).
+    Abc::WaveAbcParameters small = ap;
+    small.curvature_radius       = 2.;
+    small.cloud_radius           = 0.40;
+    Triangulation<2> tria;
+    disk(2., 3)(tria);
+    Fem::FemWaveParameters fp;
+    fp.damping   = 0.0125;
+    fp.time_step = 0.02;
+    const ScalarFunctionFromFunctionObject<2> u0(pulse);
+    Fem::FemWave<2>                           w(tria, fp, Fem::WaveBoundary::absorbing, small, u0);
+    const auto                               &st = w.absorbing_boundary().statistics();
+    check(st.min_cloud_size == 3 && st.max_cloud_size == 3 && st.max_stride == 1,
+          "disk(2, 3): every cloud x_i + 2 points along the normal, stride 1");
+    unsigned int n_up = 0;
+    const double rho  = w.one_step_spectral_radius(4000, &n_up);
+    if (root())
+      std::cout << "  disk(2, 3), x_i + 2 clouds: one-step spectral radius 1 + " << sci(rho - 1.) << std::endl;
+    // Round-off above 1 (the kept constant eigenvalue is 1 exactly).
+    check(rho <= 1. + 1e-10, "disk(2, 3), x_i + 2 clouds: one-step spectral radius " + sci(rho - 1.) +
+                               " above 1 <= 1e-10");
+  }
+
   // Exploratory (not registered): FEM_DISK_SCAN="key=value ...; ..." runs
   // of disk_wave with the EBF keys of with_wave_settings (on e13_abc
   // ("local")), plus R, T, ref (refinements of the reference disk),
@@ -987,6 +1065,59 @@ namespace
                     const std::string a = spec.substr(0, comma), b = spec.substr(comma + 1);
                     const auto cut = [](const std::string &n) { return n.find("cut") != std::string::npos; };
                     run_disk_floor(disk(R, level), named(a), cut(a), named(b), cut(b), R, T, num("w2", 9.));
+                    continue;
+                  }
+                if (kv.count("ranks"))
+                  {
+                    // ranks=N: the EBF on disk(R, level) distributed vs
+                    // serial over N steps (run with mpirun -np 2).
+                    Fem::FemWaveParameters fp;
+                    fp.damping   = 0.0125;
+                    fp.time_step = 0.02;
+                    wave_case("disk(" + std::to_string(R) + ", " + std::to_string(level) + ") EBF", disk(R, level), fp,
+                              Fem::WaveBoundary::absorbing, ap, static_cast<unsigned int>(num("ranks", 300)));
+                    continue;
+                  }
+                if (kv.count("decay"))
+                  {
+                    // decay=T1: the EBF run alone to t = T1; the energy of the
+                    // whole near field every 50 steps, its largest increase
+                    // between samples and its value at T1 (relative to E0).
+                    Fem::FemWaveParameters fp;
+                    fp.damping   = 0.0125;
+                    fp.time_step = 0.02;
+                    const double                              w2 = num("w2", 9.);
+                    const ScalarFunctionFromFunctionObject<2> u0(
+                      [w2](const Point<2> &p) { return pulse_of_width(p, w2); });
+                    Triangulation<2> tria;
+                    disk(R, level)(tria);
+                    Fem::FemWave<2>    w(tria, fp, Fem::WaveBoundary::absorbing, ap, u0);
+                    const auto         all = [](const Point<2> &) { return true; };
+                    const double       e0  = w.energy(all);
+                    double             e = e0, up = 0., t_up = 0., up_rel = 0., up_late = 0.;
+                    const unsigned int n = static_cast<unsigned int>(std::round(num("decay", 400.) / fp.time_step));
+                    for (unsigned int s = 1; s <= n; ++s)
+                      {
+                        w.advance();
+                        if (s % 50 == 0)
+                          {
+                            const double en = w.energy(all);
+                            if ((en - e) / e0 > up)
+                              {
+                                up   = (en - e) / e0;
+                                t_up = s * fp.time_step;
+                              }
+                            up_rel = std::max(up_rel, (en - e) / e);
+                            if (2 * s > n)
+                              up_late = std::max(up_late, (en - e) / e0);
+                            e = en;
+                          }
+                      }
+                    if (root())
+                      std::cout << "  decay to t = " << n * fp.time_step << ": E/E0 " << sci(e / e0)
+                                << ", largest increase between samples " << sci(up) << " E0 (at t = " << t_up
+                                << "), relative to E(t) " << sci(up_rel) << ", in the second half " << sci(up_late)
+                                << " E0" << std::endl;
                     continue;
                   }
                 DiskWaveProblem problem;
@@ -1478,6 +1609,6 @@ main(int argc, char **argv)
               {"disk_diffusion", disk_diffusion},
               {"half_derivative_history", half_derivative_history},
               {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave},
-              {"disk_wave_scan", disk_wave_scan},
+              {"disk_wave_scan", disk_wave_scan}, {"disk_wave_compact", disk_wave_compact},
               {"femball_scan", femball_scan}});
 }
