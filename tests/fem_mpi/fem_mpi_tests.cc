@@ -993,7 +993,8 @@ namespace
   // at T by boundary angle and by depth), clouds=1 (the clouds of the
   // first quadrant), and
   // rho=R0 (one-step spectral radius on disk(R0, 3 + log2(R0/2)), the
-  // boundary spacing of the disk_wave mesh) or rhoonly=1 (no run).
+  // boundary spacing of the disk_wave mesh; rholevel: refined more) or
+  // rhoonly=1 (no run).
   void
   disk_wave_scan()
   {
@@ -1013,7 +1014,8 @@ namespace
               {
                 const double     R0 = num("rho", 2.);
                 Triangulation<2> tria;
-                disk(R0, 3 + static_cast<unsigned int>(std::round(std::log2(R0 / 2.))))(tria);
+                disk(R0, 3 + static_cast<unsigned int>(std::round(std::log2(R0 / 2.))) +
+                           static_cast<unsigned int>(num("rholevel", 0)))(tria);
                 Fem::FemWaveParameters fp;
                 fp.damping   = 0.0125;
                 fp.time_step = num("dt", 0.02);
