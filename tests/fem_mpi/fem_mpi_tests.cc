@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <sstream>
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <iomanip>
@@ -50,11 +51,18 @@ namespace
     }
   };
 
+  /** Pulse exp(-log 2 |x|^2 / w2) (half width sqrt(w2)). */
+  double
+  pulse_of_width(const Point<2> &p, const double w2)
+  {
+    return std::exp(-std::log(2.) * p.square() / w2);
+  }
+
   /** Pulse of E13: exp(-log 2 |x|^2 / 9). */
   double
   pulse(const Point<2> &p)
   {
-    return std::exp(-std::log(2.) * p.square() / 9.);
+    return pulse_of_width(p, 9.);
   }
 
   using MeshMaker = std::function<void(Triangulation<2> &)>;
@@ -215,6 +223,59 @@ namespace
     return [=](Triangulation<2> &t) {
       GridGenerator::hyper_ball(t, Point<2>(), R);
       t.refine_global(refinements);
+    };
+  }
+
+  /**
+   * Disk of radius R_out whose inner part is disk(R, refinements) vertex
+   * for vertex (session 18): the refined hyper_ball, flattened, merged with
+   * a ring mesh on its boundary vertices (the same angles on every ring,
+   * rings dr apart, dr adjusted so that R_out is a ring). With MappingQ1
+   * the reference then has the near field's cells, mass and stiffness rows
+   * inside r < R, so no interpolation or mesh difference enters a
+   * near-field vs reference comparison.
+   */
+  MeshMaker
+  disk_nested(const double R, const unsigned int refinements, const double R_out, const double dr)
+  {
+    return [=](Triangulation<2> &t) {
+      Triangulation<2> ball, flat, shell;
+      GridGenerator::hyper_ball(ball, Point<2>(), R);
+      ball.refine_global(refinements);
+      GridGenerator::flatten_triangulation(ball, flat);
+      std::map<unsigned int, Point<2>> on_boundary;
+      for (const auto &cell : flat.active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->face(f)->at_boundary())
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              on_boundary[cell->face(f)->vertex_index(v)] = cell->face(f)->vertex(v);
+      std::vector<Point<2>> ring;
+      for (const auto &iv : on_boundary)
+        ring.push_back(iv.second);
+      std::sort(ring.begin(), ring.end(), [](const Point<2> &a, const Point<2> &b) {
+        return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]);
+      });
+      const unsigned int    n = ring.size(), n_rings = static_cast<unsigned int>(std::ceil((R_out - R) / dr - 1e-9));
+      std::vector<Point<2>> vertices;
+      for (unsigned int k = 0; k <= n_rings; ++k)
+        for (const Point<2> &p : ring)
+          vertices.push_back(k == 0 ? p : Point<2>(p * ((R + k * (R_out - R) / n_rings) / p.norm())));
+      std::vector<CellData<2>> cells;
+      for (unsigned int k = 0; k < n_rings; ++k)
+        for (unsigned int j = 0; j < n; ++j)
+          {
+            // Local x radial, y along the angle: right-handed.
+            CellData<2> c;
+            c.vertices[0] = k * n + j;
+            c.vertices[1] = (k + 1) * n + j;
+            c.vertices[2] = k * n + (j + 1) % n;
+            c.vertices[3] = (k + 1) * n + (j + 1) % n;
+            cells.push_back(c);
+          }
+      shell.create_triangulation(vertices, cells, SubCellData());
+      GridGenerator::merge_triangulations(flat, shell, t, 1e-9);
+      check(t.n_vertices() == flat.n_vertices() + n * n_rings && t.n_active_cells() == flat.n_active_cells() + n * n_rings,
+            "nested disk: the near field's boundary vertices are shared with the ring mesh");
     };
   }
 
@@ -526,6 +587,8 @@ namespace
     double f_ebf = 0., f_first = 0.;
     /** Largest |E(t) - E_ref(t)|/E0 over the samples of the second half of the run (EBF). */
     double late_ebf = 0.;
+    /** Smallest and largest cloud (points, x_i included) and largest thinning stride of the EBF. */
+    unsigned int min_cloud = 0, max_cloud = 0, max_stride = 0;
   };
 
   /** Diagnostics of run_disk_wave (exploratory scan only; the defaults are the test's run). */
@@ -541,10 +604,26 @@ namespace
     bool clouds = false;
   };
 
+  /**
+   * The initial data of run_disk_wave (session 18; the defaults are
+   * fem_mpi.disk_wave's problem).
+   */
+  struct DiskWaveProblem
+  {
+    /** The pulse exp(-log 2 |x - c|^2 / w2). */
+    double width2 = 9.;
+    /**
+     * Zero the reference's initial data outside r = R (the data an ABC can
+     * represent: the near field's own data and nothing outside).
+     */
+    bool truncate_reference = false;
+  };
+
   DiskWaveResult
   run_disk_wave(const MeshMaker &near_mesh, const MeshMaker &far_mesh, const double R, const double T,
                 const Abc::WaveAbcParameters &ap, const bool newmark = false,
-                const DiskWaveDiagnostics &diag = DiskWaveDiagnostics())
+                const DiskWaveDiagnostics &diag = DiskWaveDiagnostics(),
+                const DiskWaveProblem &problem = DiskWaveProblem())
   {
     Fem::FemWaveParameters fp;
     fp.damping   = 0.0125;
@@ -555,12 +634,17 @@ namespace
         fp.lumped_mass = false;
       }
     const Point<2>                            c0 = diag.centre;
+    const double                              w2 = problem.width2;
     const ScalarFunctionFromFunctionObject<2> u0(
-      [c0](const Point<2> &p) { return pulse(Point<2>(p - c0)); });
+      [c0, w2](const Point<2> &p) { return pulse_of_width(Point<2>(p - c0), w2); });
+    const bool                                cut = problem.truncate_reference;
+    const ScalarFunctionFromFunctionObject<2> u0_ref([c0, w2, cut, R](const Point<2> &p) {
+      return cut && p.norm() > R * (1. + 1e-9) ? 0. : pulse_of_width(Point<2>(p - c0), w2);
+    });
     Triangulation<2>                          near, far;
     near_mesh(near);
     far_mesh(far);
-    Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0);
+    Fem::FemWave<2> ref(far, fp, Fem::WaveBoundary::dirichlet, ap, u0_ref);
     Fem::FemWave<2> first(near, fp, Fem::WaveBoundary::first_order, ap, u0);
     Fem::FemWave<2> ebf(near, fp, Fem::WaveBoundary::absorbing, ap, u0);
     const auto     &st = ebf.absorbing_boundary().statistics();
@@ -592,10 +676,13 @@ namespace
           }
       }
     const auto inside = [R](const Point<2> &p) { return p.norm() < R - 0.5; };
+    DiskWaveResult     r;
     const double       e0      = ref.energy(inside);
+    r.min_cloud                = st.min_cloud_size;
+    r.max_cloud                = st.max_cloud_size;
+    r.max_stride               = st.max_stride;
     const unsigned int n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
     const Point<2>     probe(0.625 * R, 0.3125 * R);
-    DiskWaveResult     r;
     for (unsigned int s = 1; s <= n_steps; ++s)
       {
         ref.advance();
@@ -701,6 +788,59 @@ namespace
   }
 
   /**
+   * Difference of two extended-disk (Dirichlet) runs in the metrics of
+   * run_disk_wave (session 18): max over the 16 samples of
+   * |E_b - E_a|/E0_a over the cells with centre r < R - 0.5 (each on its
+   * own mesh), of |u_b - u_a| at the probe, and max |u_b - u_a| over the
+   * vertices of @p near_mesh at T. @p cut_a / @p cut_b: zero initial data
+   * outside r = R. This is the floor an ABC comparison against run a has
+   * when run b is what the ABC can at best reproduce.
+   */
+  std::array<double, 3>
+  run_disk_floor(const MeshMaker &near_mesh, const MeshMaker &mesh_a, const bool cut_a, const MeshMaker &mesh_b,
+                 const bool cut_b, const double R, const double T, const double w2)
+  {
+    Fem::FemWaveParameters fp;
+    fp.damping   = 0.0125;
+    fp.time_step = 0.02;
+    const auto data = [R, w2](const bool cut) {
+      return ScalarFunctionFromFunctionObject<2>(
+        [R, w2, cut](const Point<2> &p) { return cut && p.norm() > R * (1. + 1e-9) ? 0. : pulse_of_width(p, w2); });
+    };
+    const ScalarFunctionFromFunctionObject<2> u0_a = data(cut_a), u0_b = data(cut_b);
+    Triangulation<2>                          near, ta, tb;
+    near_mesh(near);
+    mesh_a(ta);
+    mesh_b(tb);
+    const Abc::WaveAbcParameters ap;
+    Fem::FemWave<2>              a(ta, fp, Fem::WaveBoundary::dirichlet, ap, u0_a);
+    Fem::FemWave<2>              b(tb, fp, Fem::WaveBoundary::dirichlet, ap, u0_b);
+    const auto                   inside  = [R](const Point<2> &p) { return p.norm() < R - 0.5; };
+    const double                 e0      = a.energy(inside);
+    const unsigned int           n_steps = static_cast<unsigned int>(std::round(T / fp.time_step));
+    const Point<2>               probe(0.625 * R, 0.3125 * R);
+    std::array<double, 3>        r{{0., 0., 0.}};
+    for (unsigned int s = 1; s <= n_steps; ++s)
+      {
+        a.advance();
+        b.advance();
+        if (s % (n_steps / 16) == 0)
+          {
+            r[0] = std::max(r[0], std::abs(b.energy(inside) - a.energy(inside)) / e0);
+            r[1] = std::max(r[1], std::abs(b.value_at(probe) - a.value_at(probe)));
+          }
+      }
+    for (const auto &cell : near.active_cell_iterators())
+      for (const unsigned int v : cell->vertex_indices())
+        r[2] = std::max(r[2], std::abs(b.value_at(cell->vertex(v)) - a.value_at(cell->vertex(v))));
+    if (root())
+      std::cout << "  floor: " << ta.n_active_cells() << " vs " << tb.n_active_cells()
+                << " cells: max |E_b - E_a|/E0 " << sci(r[0]) << ", probe " << sci(r[1]) << ", field at T "
+                << sci(r[2]) << std::endl;
+    return r;
+  }
+
+  /**
    * E13-type viscous waves in the disk of radius 8 (h ~ 0.4, Q1 lumped,
    * velocity Verlet, local dispersion) against the extended disk of radius
    * 18 (nothing reflected there is back before t = 16) and the first-order
@@ -758,16 +898,103 @@ namespace
     check(rho <= 1. + 1e-10, "disk EBF, curved modes: one-step spectral radius " + sci(rho - 1.) + " above 1 <= 1e-10");
   }
 
+  /**
+   * Session 18: the disk comparison of disk_wave made well posed (issue 4).
+   * disk_wave's pulse (half width 3) is still 7.2e-3 at r = R = 8, with zero
+   * velocity. The reference has the part outside R too, and half of that
+   * travels inward. The near field does not have it, so no ABC can
+   * reproduce it. Measured (design.md, session 18): that floor alone is
+   * 1.96e-3 in energy against the first-order ABC's 1.16e-2, i.e. above
+   * the 1.16e-3 a 10x needs, and the non-nested reference hyper_ball adds
+   * 3.7e-3 (its cells with centre r < 7.5 are not the near field's). Here
+   * the pulse has half width sqrt(3.2) (u0(R) = 1e-6, tail floor 1.6e-8 in
+   * energy), the reference is disk_nested (the near field's cells inside
+   * R; rings 0.2 apart to R_ref, dr / 2: 2.6e-5 in energy), and every
+   * cloud is x_i + 2 points along the normal (d_inf = 0.4137 = 2.05 h; the
+   * default 2 h mixes x_i + 1 and x_i + 2, session 17).
+   */
+  void
+  disk_wave_compact()
+  {
+    const double           R = 8., T = 16., R_ref = 0.5 * (T + R + 6.) + 3.;
+    Abc::WaveAbcParameters ap = e13_abc("local");
+    ap.curvature_radius       = R;
+    ap.n_directions           = 0;
+    ap.cloud_radius           = 0.4137;
+    DiskWaveProblem problem;
+    problem.width2 = 3.2;
+    // The data an ABC cannot represent: u0 at the boundary, ~1e-6.
+    check(pulse_of_width(Point<2>(R, 0.), problem.width2) < 1.1e-6, "compact pulse: u0(R) < 1.1e-6");
+    const auto r = run_disk_wave(disk(R, 5), disk_nested(R, 5, R_ref, 0.2), R, T, ap, false, DiskWaveDiagnostics(),
+                                 problem);
+    // The premise: x_i + 2 points in every cloud, none thinned.
+    check(r.min_cloud == 3 && r.max_cloud == 3 && r.max_stride == 1,
+          "compact disk: every cloud x_i + 2 points along the normal, stride 1");
+    // Measured: energy 1.117e-4 vs first order 3.550e-3 (31.8x), probe
+    // 1.253e-3 vs 1.589e-2 (12.7x), field at T 1.763e-3 vs 4.715e-2
+    // (26.7x). The 10x is the issue's. The absolute bounds are ~30 % above
+    // the measured values: the run is deterministic, so the margin only
+    // covers compilers and BLAS, and it is far below the default clouds'
+    // 1.21e-3 / 9.9e-3 / 1.39e-2 on this problem.
+    check(r.e_ebf < 1.5e-4 && 10. * r.e_ebf < r.e_first,
+          "compact disk EBF: max |E - E_ref|/E0 = " + sci(r.e_ebf) + " < 1.5e-4 and 10x below first order (" +
+            sci(r.e_first) + ")");
+    check(r.p_ebf < 1.6e-3 && 10. * r.p_ebf < r.p_first,
+          "compact disk EBF: probe " + sci(r.p_ebf) + " < 1.6e-3 and 10x below first order (" + sci(r.p_first) + ")");
+    check(r.f_ebf < 2.3e-3 && 10. * r.f_ebf < r.f_first,
+          "compact disk EBF: field at t = T " + sci(r.f_ebf) + " < 2.3e-3 and 10x below first order (" +
+            sci(r.f_first) + ")");
+    // The diagnosis, guarded: on disk_wave's problem (half width 3, the
+    // hyper_ball reference) the reference with its data zeroed outside R
+    // (what an ideal ABC reproduces) differs from the full reference by
+    // 1.96e-3 in energy (measured), more than disk_wave's first-order bound
+    // 1.4e-2 / 10, so no ABC can show 10x there in energy. Bound: that
+    // 1.4e-3, 30 % below the measured value.
+    const auto floor = run_disk_floor(disk(R, 5), disk(R_ref, 6), false, disk(R_ref, 6), true, R, T, 9.);
+    check(floor[0] > 1.4e-3, "disk_wave's problem: the tail outside R alone moves the energy by " + sci(floor[0]) +
+                               " > 1.4e-3 (disk_wave's first-order bound / 10)");
+    // Stability: the one-step map on disk(2, 3) (the same boundary spacing)
+    // with clouds of the same kind (d_inf 0.40 there gives x_i + 2 in every
+    // cloud; 0.4137 thins some to x_i + 1 at stride 2: 1 + 4.4e-4). Measured
+    // 1 + 1.2e-14 (0 eigenvalues above 1 + 1e-8); disk(4, 4), rho 4, d_inf
+    // 0.4137 (every cloud x_i + 2): 1 + 0 (design.md, session 18).
+    Abc::WaveAbcParameters small = ap;
+    small.curvature_radius       = 2.;
+    small.cloud_radius           = 0.40;
+    Triangulation<2> tria;
+    disk(2., 3)(tria);
+    Fem::FemWaveParameters fp;
+    fp.damping   = 0.0125;
+    fp.time_step = 0.02;
+    const ScalarFunctionFromFunctionObject<2> u0(pulse);
+    Fem::FemWave<2>                           w(tria, fp, Fem::WaveBoundary::absorbing, small, u0);
+    const auto                               &st = w.absorbing_boundary().statistics();
+    check(st.min_cloud_size == 3 && st.max_cloud_size == 3 && st.max_stride == 1,
+          "disk(2, 3): every cloud x_i + 2 points along the normal, stride 1");
+    unsigned int n_up = 0;
+    const double rho  = w.one_step_spectral_radius(4000, &n_up);
+    if (root())
+      std::cout << "  disk(2, 3), x_i + 2 clouds: one-step spectral radius 1 + " << sci(rho - 1.) << std::endl;
+    // Round-off above 1 (the kept constant eigenvalue is 1 exactly).
+    check(rho <= 1. + 1e-10, "disk(2, 3), x_i + 2 clouds: one-step spectral radius " + sci(rho - 1.) +
+                               " above 1 <= 1e-10");
+  }
+
   // Exploratory (not registered): FEM_DISK_SCAN="key=value ...; ..." runs
   // of disk_wave with the EBF keys of with_wave_settings (on e13_abc
   // ("local")), plus R, T, ref (refinements of the reference disk),
+  // session 18: nested=1 (reference disk_nested, rings dr apart (dr, 0.2),
+  // grow: R_ref larger by that), w2 (pulse exp(-log 2 |x|^2 / w2)), cut=1
+  // (the reference's data zero outside R), floor=A,B (run_disk_floor; see
+  // below), decay=T1 (EBF energy to T1), ranks=N (1 vs N ranks, mpirun),
   // newmark=1, level (near refinement at R = 8), cloudh (d_inf / h),
   // x0, y0 (pulse centre; diagnostic), series=1 (signed energy errors and
   // max vertex errors, boundary / inside, at every sample), where=1 (error
   // at T by boundary angle and by depth), clouds=1 (the clouds of the
   // first quadrant), and
   // rho=R0 (one-step spectral radius on disk(R0, 3 + log2(R0/2)), the
-  // boundary spacing of the disk_wave mesh) or rhoonly=1 (no run).
+  // boundary spacing of the disk_wave mesh; rholevel: refined more) or
+  // rhoonly=1 (no run).
   void
   disk_wave_scan()
   {
@@ -787,7 +1014,8 @@ namespace
               {
                 const double     R0 = num("rho", 2.);
                 Triangulation<2> tria;
-                disk(R0, 3 + static_cast<unsigned int>(std::round(std::log2(R0 / 2.))))(tria);
+                disk(R0, 3 + static_cast<unsigned int>(std::round(std::log2(R0 / 2.))) +
+                           static_cast<unsigned int>(num("rholevel", 0)))(tria);
                 Fem::FemWaveParameters fp;
                 fp.damping   = 0.0125;
                 fp.time_step = num("dt", 0.02);
@@ -826,13 +1054,96 @@ namespace
                     if (root())
                       std::cout << "  h = " << h << ", d_inf = " << ap.cloud_radius << std::endl;
                   }
+                // Session 18: the reference disk nested (nested=1, rings
+                // dr apart, out to R_ref + grow), the pulse width (w2), the
+                // reference's data zero outside R (cut=1).
+                const double dr = num("dr", 0.2), R_big = R_ref + num("grow", 0.);
+                const MeshMaker far_mesh =
+                  kv.count("nested") ? disk_nested(R, level, R_big, dr) :
+                                       disk(R_big, static_cast<unsigned int>(num("ref", level + 1)));
+                if (kv.count("floor"))
+                  {
+                    // floor=A,B: run b against run a; each of std (hyper_ball
+                    // R_ref, refinement level + 1), stdcut, nest, nestcut,
+                    // nestfine (dr / 2), nestbig (R_ref + 4).
+                    const std::string spec = kv.at("floor");
+                    const auto        comma = spec.find(',');
+                    const auto        named = [&](const std::string &n) {
+                      if (n.rfind("std", 0) == 0)
+                        return disk(R_ref, level + 1);
+                      if (n.rfind("nestfine", 0) == 0)
+                        return disk_nested(R, level, R_ref, 0.5 * dr);
+                      if (n.rfind("nestbig", 0) == 0)
+                        return disk_nested(R, level, R_ref + 4., dr);
+                      return disk_nested(R, level, R_ref, dr);
+                    };
+                    const std::string a = spec.substr(0, comma), b = spec.substr(comma + 1);
+                    const auto cut = [](const std::string &n) { return n.find("cut") != std::string::npos; };
+                    run_disk_floor(disk(R, level), named(a), cut(a), named(b), cut(b), R, T, num("w2", 9.));
+                    continue;
+                  }
+                if (kv.count("ranks"))
+                  {
+                    // ranks=N: the EBF on disk(R, level) distributed vs
+                    // serial over N steps (run with mpirun -np 2).
+                    Fem::FemWaveParameters fp;
+                    fp.damping   = 0.0125;
+                    fp.time_step = 0.02;
+                    wave_case("disk(" + std::to_string(R) + ", " + std::to_string(level) + ") EBF", disk(R, level), fp,
+                              Fem::WaveBoundary::absorbing, ap, static_cast<unsigned int>(num("ranks", 300)));
+                    continue;
+                  }
+                if (kv.count("decay"))
+                  {
+                    // decay=T1: the EBF run alone to t = T1; the energy of the
+                    // whole near field every 50 steps, its largest increase
+                    // between samples and its value at T1 (relative to E0).
+                    Fem::FemWaveParameters fp;
+                    fp.damping   = 0.0125;
+                    fp.time_step = 0.02;
+                    const double                              w2 = num("w2", 9.);
+                    const ScalarFunctionFromFunctionObject<2> u0(
+                      [w2](const Point<2> &p) { return pulse_of_width(p, w2); });
+                    Triangulation<2> tria;
+                    disk(R, level)(tria);
+                    Fem::FemWave<2>    w(tria, fp, Fem::WaveBoundary::absorbing, ap, u0);
+                    const auto         all = [](const Point<2> &) { return true; };
+                    const double       e0  = w.energy(all);
+                    double             e = e0, up = 0., t_up = 0., up_rel = 0., up_late = 0.;
+                    const unsigned int n = static_cast<unsigned int>(std::round(num("decay", 400.) / fp.time_step));
+                    for (unsigned int s = 1; s <= n; ++s)
+                      {
+                        w.advance();
+                        if (s % 50 == 0)
+                          {
+                            const double en = w.energy(all);
+                            if ((en - e) / e0 > up)
+                              {
+                                up   = (en - e) / e0;
+                                t_up = s * fp.time_step;
+                              }
+                            up_rel = std::max(up_rel, (en - e) / e);
+                            if (2 * s > n)
+                              up_late = std::max(up_late, (en - e) / e0);
+                            e = en;
+                          }
+                      }
+                    if (root())
+                      std::cout << "  decay to t = " << n * fp.time_step << ": E/E0 " << sci(e / e0)
+                                << ", largest increase between samples " << sci(up) << " E0 (at t = " << t_up
+                                << "), relative to E(t) " << sci(up_rel) << ", in the second half " << sci(up_late)
+                                << " E0" << std::endl;
+                    continue;
+                  }
+                DiskWaveProblem problem;
+                problem.width2             = num("w2", 9.);
+                problem.truncate_reference = kv.count("cut") > 0;
                 DiskWaveDiagnostics diag;
                 diag.centre = Point<2>(num("x0", 0.), num("y0", 0.));
                 diag.series = kv.count("series") > 0;
                 diag.where  = kv.count("where") > 0;
                 diag.clouds = kv.count("clouds") > 0;
-                const auto r = run_disk_wave(disk(R, level), disk(R_ref, static_cast<unsigned int>(num("ref", level + 1))),
-                                             R, T, ap, kv.count("newmark") > 0, diag);
+                const auto r = run_disk_wave(disk(R, level), far_mesh, R, T, ap, kv.count("newmark") > 0, diag, problem);
                 if (root())
                   std::cout << "  late energy error EBF " << sci(r.late_ebf) << std::endl;
               }
@@ -1313,6 +1624,6 @@ main(int argc, char **argv)
               {"disk_diffusion", disk_diffusion},
               {"half_derivative_history", half_derivative_history},
               {"disk_wave", disk_wave}, {"diffusion_3d_cube_ball", diffusion_3d_cube_ball}, {"rank_invariance_wave", rank_invariance_wave},
-              {"disk_wave_scan", disk_wave_scan},
+              {"disk_wave_scan", disk_wave_scan}, {"disk_wave_compact", disk_wave_compact},
               {"femball_scan", femball_scan}});
 }
