@@ -31,3 +31,5 @@ perideal_add_test(NAME fem_abc.newmark_e13_tikhonov COMMAND $<TARGET_FILE:fem_ab
 # energy decay: unit; E13 ratios: 22-40 s, in CI as the option's accuracy test).
 perideal_add_test(NAME fem_abc.newmark_wake_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_wake_stability LABELS unit)
 perideal_add_test(NAME fem_abc.newmark_e13_wake COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake LABELS convergence TIMEOUT 1200)
+# E13 at the source's size with the source's mode set (Newmark + consistent mass).
+perideal_add_test(NAME fem_abc.newmark_e13_source_size COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_source_size LABELS convergence TIMEOUT 1200)
