@@ -27,7 +27,7 @@ namespace PeriDEALTests
     return kv;
   }
 
-  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk). */
+  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk, points, layer). */
   inline PeriDEAL::Abc::WaveAbcParameters
   with_wave_settings(PeriDEAL::Abc::WaveAbcParameters p, const std::map<std::string, std::string> &kv)
   {
@@ -51,6 +51,8 @@ namespace PeriDEALTests
     p.curvature_radius         = num("curv", p.curvature_radius);
     p.wake_curvature_radius    = num("wcurv", p.wake_curvature_radius);
     p.wake_wave_number         = num("wk", p.wake_wave_number);
+    p.cloud_points             = str("points", p.cloud_points);
+    p.layer_thickness          = num("layer", p.layer_thickness);
     return p;
   }
 

@@ -952,6 +952,11 @@ namespace
     double ebf_small = 0., ebf_large = 0., first_order = 0., free = 0., peak = 0.;
     /** Max probe error of the small EBF run over (T, tmul T]. */
     double ebf_small_late = 0.;
+    /**
+     * Field errors at T: sum (u - u_ref)^2 over the nodes with r < R1 - delta
+     * / sum u0^2 there (EBF R1, EBF R2, first order R1, free R1).
+     */
+    double field_small = 0., field_large = 0., field_first_order = 0., field_free = 0.;
     std::uint64_t n_broken = 0;
     bool          same_bonds = true;
   };
@@ -991,7 +996,28 @@ namespace
    * the free truncation at the small radius.
    */
   NotchErrors
+  e15_notches(const std::function<WaveAbcParameters(double)> &parameters, const double scale, const double tmul = 1.,
+              const double dt = 0.02);
+
+  NotchErrors
   e15_notches(const WaveAbcParameters &prm, const double scale, const double tmul = 1., const double dt = 0.02)
+  {
+    return e15_notches([prm](double) { return prm; }, scale, tmul, dt);
+  }
+
+  /** The E15 layer setting (doc/design.md, session 11). */
+  WaveAbcParameters
+  e15_parameters();
+
+  /**
+   * As above with the EBF parameters of each disc, parameters(R) (e.g. a
+   * curvature radius equal to R). The first-order and free runs at R1 always
+   * take e15_parameters() (the first-order ABC reads the cone and cloud
+   * radius), so that every EBF setting is compared with the same baseline.
+   */
+  NotchErrors
+  e15_notches(const std::function<WaveAbcParameters(double)> &parameters, const double scale, const double tmul,
+              const double dt)
   {
     const double R1 = 26. * scale, R2 = 42. * scale, T = 50. * scale;
     LatticeParameters    lp;
@@ -1015,8 +1041,11 @@ namespace
     for (const auto &su : setups)
       {
         runs.emplace_back(std::make_unique<PdUnboundedWave<2>>(MPI_COMM_WORLD));
-        runs.back()->setup(BallDomain<2>(Point<2>(), su.first), lp, mp, su.second, prm, u0, notches);
+        runs.back()->setup(BallDomain<2>(Point<2>(), su.first), lp, mp, su.second,
+                           su.second == WaveTruncation::absorbing ? parameters(su.first) : e15_parameters(), u0, notches);
       }
+    const auto inner = [&](const Point<2> &p) { return p.norm() < R1 - lp.delta - 1e-9; };
+    const double norm0 = sum_squares(runs[0]->gather(inner));
     NotchErrors e;
     e.n_broken = runs[0]->n_broken_bonds();
     for (const auto &r : runs)
@@ -1038,6 +1067,13 @@ namespace
         e.peak = std::max(e.peak, std::abs(ur));
         for (unsigned int q = 1; q < runs.size(); ++q)
           err[q] = std::max(err[q], std::abs(runs[q]->value_at(probe) - ur));
+        if (s == n_steps)
+          {
+            const auto ref_field = runs[0]->gather(inner);
+            double    *field[]   = {nullptr, &e.field_small, &e.field_large, &e.field_first_order, &e.field_free};
+            for (unsigned int q = 1; q < runs.size(); ++q)
+              *field[q] = field_difference(runs[q]->gather(inner), ref_field, lp.dx) / norm0;
+          }
       }
     e.ebf_small   = err[1];
     e.ebf_large   = err[2];
@@ -1048,11 +1084,11 @@ namespace
                 << ": max |u - u_ref| at (" << probe << "): EBF R = " << R1 << " " << sci(e.ebf_small) << ", R = " << R2 << " "
                 << sci(e.ebf_large) << ", first-order R = " << R1 << " " << sci(e.first_order) << ", free " << sci(e.free)
                 << " (max |u_ref| there " << sci(e.peak) << ")" << (tmul > 1. ? ", EBF R1 after T " + sci(e.ebf_small_late) : "")
-                << std::endl;
+                << "; field error at T on r < R1 - delta: EBF R1 " << sci(e.field_small) << ", R2 " << sci(e.field_large)
+                << ", first-order " << sci(e.field_first_order) << ", free " << sci(e.field_free) << std::endl;
     return e;
   }
 
-  /** The E15 layer setting (doc/design.md, session 11). */
   WaveAbcParameters
   e15_parameters()
   {
@@ -2229,6 +2265,133 @@ namespace
       }
   }
 
+  /**
+   * Scan of EBF layer settings for E15 (m = 3; not a ctest: a tool for
+   * doc/design.md, session 18). Does nothing unless E15_SCAN="key=value ...;
+   * ..." is set; one setting per ';'-separated item, each on top of the
+   * source's layer (WaveAbcParameters(): n_phi 10, Delta phi pi/4, cone
+   * pi/4, d_inf = delta, full pseudo-inverse, value form). Keys: the EBF
+   * keys of with_wave_settings (form, nphi, dphi, dk, nk, cone, cloud, tol,
+   * reg, levels, disp, maxv, thin; curv > 0: curvature radius = the radius
+   * of each disc); radii=2.5,4 (one-step radius of these discs, 0: none),
+   * dts=0.02,0.005 (their time steps); run=s (E15 at scale s: 0.5 the CI
+   * size, 1 the source's; probe error over [0, T] and field error at T of
+   * the EBF runs at both radii, first order and free at R1 with
+   * e15_parameters()), tmul (run to tmul T), rdt (time step of the run,
+   * 0.02); trans=n (the (4.99) energy of all nodes from rough_state() at
+   * every one of n steps on the disc long_R, default 13: peak, rises between
+   * steps and between samples every N steps).
+   */
+  void
+  e15_scan()
+  {
+    const char *env = std::getenv("E15_SCAN");
+    if (!env)
+      return;
+    std::istringstream in(env);
+    std::string        item;
+    while (std::getline(in, item, ';'))
+      {
+        const auto kv  = key_values(item);
+        const auto num = [&](const std::string &k, const double dflt) { return kv.count(k) ? std::stod(kv.at(k)) : dflt; };
+        const auto list = [&](const std::string &k, const std::string &dflt) {
+          std::string l = kv.count(k) ? kv.at(k) : dflt;
+          std::replace(l.begin(), l.end(), ',', ' ');
+          return l;
+        };
+        const WaveAbcParameters base   = with_wave_settings(WaveAbcParameters(), kv);
+        const bool              curved = base.curvature_radius > 0.;
+        const auto              prm    = [&](const double R) {
+          WaveAbcParameters q = base;
+          q.curvature_radius  = curved ? R : 0.;
+          return q;
+        };
+        std::cout << "  {" << item << "}" << std::endl;
+        std::istringstream radii(list("radii", "2.5"));
+        double             Rd = 0.;
+        while (radii >> Rd && Rd > 0.)
+          {
+            std::istringstream dts(list("dts", "0.02"));
+            double             dt = 0.;
+            while (dts >> dt)
+              try
+                {
+                  Timer               timer;
+                  unsigned int        n_up = 0;
+                  WaveCloudStatistics st;
+                  const double r = radius_2d(Rd, prm(Rd), 0.25, 3, &n_up, &st, nullptr, nullptr, WaveTruncation::absorbing, dt);
+                  std::cout << "    R " << Rd << " dt " << dt << ": rho - 1 = " << sci(r - 1.) << " (" << n_up
+                            << " > 1 + 1e-8), clouds " << st.min_cloud_size << ".." << st.max_cloud_size << " thinned "
+                            << st.n_thinned << "/" << st.n_absorbing << " cond " << sci(st.max_condition_number)
+                            << " max|V| " << sci(st.max_update_norm) << " (" << sci(timer.cpu_time()) << " s)" << std::endl;
+                }
+              catch (const std::exception &e)
+                {
+                  std::cout << "    R " << Rd << " dt " << dt << ": setup failed: " << std::string(e.what()).substr(0, 300)
+                            << std::endl;
+                }
+          }
+        if (num("run", 0.) > 0.)
+          try
+            {
+              Timer             timer;
+              const NotchErrors e = e15_notches(prm, num("run", 0.), num("tmul", 1.), num("rdt", 0.02));
+              std::cout << "    E15 scale " << num("run", 0.) << " (" << sci(timer.cpu_time()) << " s): probe EBF R1 "
+                        << sci(e.ebf_small) << " (first order / EBF " << e.first_order / e.ebf_small << "), R2 "
+                        << sci(e.ebf_large) << "; field at T EBF R1 " << sci(e.field_small) << " (first order / EBF "
+                        << e.field_first_order / e.field_small << "), R2 " << sci(e.field_large) << std::endl;
+            }
+          catch (const std::exception &ex)
+            {
+              std::cout << "    E15 run: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
+            }
+        if (num("trans", 0.) > 0.)
+          try
+            {
+              LatticeParameters    lp;
+              ScalarWaveParameters mp;
+              e15_model(lp, mp, num("rdt", 0.02));
+              const double       Rl = num("long_R", 13.);
+              PdUnboundedWave<2> pd(MPI_COMM_SELF);
+              pd.setup(BallDomain<2>(Point<2>(), Rl), lp, mp, WaveTruncation::absorbing, prm(Rl), rough_state());
+              const auto          all = [](const Point<2> &) { return true; };
+              const unsigned long n   = static_cast<unsigned long>(num("trans", 0.));
+              std::vector<double> e{pd.energy(all)};
+              unsigned long       n_up = 0, first_up = 0, peak_step = 0;
+              double              max_rel = -1.;
+              for (unsigned long s = 1; s <= n; ++s)
+                {
+                  pd.advance();
+                  e.push_back(pd.energy(all));
+                  if (e[s] > e[s - 1])
+                    {
+                      ++n_up;
+                      first_up = first_up ? first_up : s;
+                      max_rel  = std::max(max_rel, e[s] / e[s - 1] - 1.);
+                    }
+                  if (e[s] > e[peak_step])
+                    peak_step = s;
+                }
+              std::cout << "    rough state R = " << Rl << ", " << n << " steps: peak E/E0 " << sci(e[peak_step] / e[0])
+                        << " at step " << peak_step << ", E_end/E0 " << sci(e.back() / e[0]) << ", steps with E up " << n_up
+                        << " (first " << first_up << ", largest " << sci(max_rel) << "); samples every N from 0 up:";
+              for (const unsigned long every : {10ul, 100ul, 1000ul})
+                if (every <= n / 2)
+                  {
+                    unsigned int ups = 0;
+                    for (unsigned long s = every; s <= n; s += every)
+                      ups += e[s] > e[s - every];
+                    std::cout << " " << every << ":" << ups;
+                  }
+              std::cout << std::endl;
+            }
+          catch (const std::exception &ex)
+            {
+              std::cout << "    rough state: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
+            }
+      }
+  }
+
 } // namespace
 
 int
@@ -2258,5 +2421,6 @@ main(int argc, char **argv)
               {"pml_scan", pml_scan},
               {"pd_2d_stable", [] { pd_2d_stable(false); }},
               {"pd_2d_stable_long", [] { pd_2d_stable(true); }},
-              {"e14_scan", e14_scan}});
+              {"e14_scan", e14_scan},
+              {"e15_scan", e15_scan}});
 }
