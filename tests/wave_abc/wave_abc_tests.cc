@@ -1195,6 +1195,7 @@ namespace
       }
   }
 
+
   // The one-step spectral radius diagnostic and the setup guard built on it.
   void
   spectral_radius()
@@ -2265,6 +2266,62 @@ namespace
       }
   }
 
+  // E15 with the source's direction set (doc/design.md, session 18):
+  // e15_source_modes_parameters(), n_phi = 10 directions in [-pi/4, pi/4]
+  // about the normal, stable with the increment form, Tikhonov lambda =
+  // 1.5e-3 sigma_max, 3.5 dx clouds in the wide cone 0.4, curved modes and
+  // Delta k = 2. CI halved as pd_2d_notches; the first-order and free runs
+  // take e15_parameters() (the same baseline as pd_2d_notches).
+  void
+  pd_2d_notches_source(const bool full)
+  {
+    const NotchErrors e = e15_notches(e15_source_modes_parameters, full ? 1. : 0.5);
+    const double      probe_ratio = e.first_order / e.ebf_small, field_ratio = e.field_first_order / e.field_small;
+    if (root())
+      std::cout << "    source's directions: first order / EBF at R1: probe " << probe_ratio << ", field at T " << field_ratio
+                << std::endl;
+    check(e.n_broken > 0 && e.same_bonds, "notches break the same bonds in every near field");
+    // The source's comparison (R = 42 "considerably better" than R = 26):
+    // measured ratio 1.0e2 (CI); asserted 10x as pd_2d_notches.
+    check(e.ebf_large < 0.1 * e.ebf_small, "E15 (source's directions): error(larger R) < 0.1 error(smaller R): " + sci(e.ebf_large) + " vs " + sci(e.ebf_small));
+    // EBF vs first order at the smaller R. Measured (CI) probe 5.84x, field
+    // at T 45x. Asserted 4x / 20x: above what e15_parameters() reaches
+    // (2.3x / 3.4x), so a fall back to that level fails; below the
+    // measured values by a margin that covers round-off and compiler
+    // differences of these deterministic runs (the neighbouring settings of
+    // the scan give 5.3-6.7x / 41-49x).
+    check(probe_ratio > 4., "E15 (source's directions), smaller R: probe error at least 4x below first order (" + sci(e.ebf_small) + " vs " + sci(e.first_order) + ")");
+    check(field_ratio > 20., "E15 (source's directions), smaller R: field error at T at least 20x below first order (" + sci(e.field_small) + " vs " + sci(e.field_first_order) + ")");
+    if (!full && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
+      {
+        // One-step map of the R = 2.5 disc at dt = 0.02 and 0.005 (measured
+        // 1 - 5.2e-5 and 1 - RHO2).
+        for (const double dt : {0.02, 0.005})
+          {
+            unsigned int n_up = 0;
+            const double rho  = radius_2d(2.5, e15_source_modes_parameters(2.5), 0.25, 3, &n_up, nullptr, nullptr, nullptr,
+                                         WaveTruncation::absorbing, dt);
+            std::cout << "    source's directions, m = 3, R = 2.5, dt = " << dt << ": rho - 1 = " << sci(rho - 1.) << " ("
+                      << n_up << " eigenvalues > 1 + 1e-8)" << std::endl;
+            check(rho <= 1. + 1e-8, "E15 source's directions: one-step spectral radius <= 1 + 1e-8 (m = 3, R = 2.5, dt = " + std::to_string(dt) + ")");
+          }
+        // The (4.99) energy of all nodes of the R = 13 disc from the rough
+        // state, sampled every 100 steps over 5000 steps: every sample below
+        // the previous one (measured: none above; single steps rise at
+        // NUPS of 20,000, so steps are not compared one by one).
+        LatticeParameters    lp;
+        ScalarWaveParameters mp;
+        e15_model(lp, mp, 0.02);
+        PdUnboundedWave<2> pd(MPI_COMM_SELF);
+        pd.setup(BallDomain<2>(Point<2>(), 13.), lp, mp, WaveTruncation::absorbing, e15_source_modes_parameters(13.),
+                 rough_state());
+        const std::vector<double> energy = sampled_energy(pd, 5000, 50);
+        const double              inc    = max_relative_increase(energy);
+        std::cout << "    source's directions, R = 13, rough state, 5000 steps: E_end/E0 " << sci(energy.back() / energy[0])
+                  << ", largest change between 100-step samples " << sci(inc) << std::endl;
+        check(inc < 0., "E15 source's directions: energy from the rough state (R = 13) decreasing between samples every 100 steps over 5000 steps (largest change " + sci(inc) + ")");
+      }
+  }
   /**
    * Scan of EBF layer settings for E15 (m = 3; not a ctest: a tool for
    * doc/design.md, session 18). Does nothing unless E15_SCAN="key=value ...;
@@ -2411,6 +2468,8 @@ main(int argc, char **argv)
               {"pd_1d_dispersive_full", [] { pd_1d_dispersive(true); }},
               {"pd_2d_notches", [] { pd_2d_notches(false); }},
               {"pd_2d_notches_full", [] { pd_2d_notches(true); }},
+              {"pd_2d_notches_source", [] { pd_2d_notches_source(false); }},
+              {"pd_2d_notches_source_full", [] { pd_2d_notches_source(true); }},
               {"sponge", sponge},
               {"abc_skipped", abc_skipped},
               {"shared_vectors", shared_vectors},
