@@ -2281,21 +2281,27 @@ namespace
       std::cout << "    source's directions: first order / EBF at R1: probe " << probe_ratio << ", field at T " << field_ratio
                 << std::endl;
     check(e.n_broken > 0 && e.same_bonds, "notches break the same bonds in every near field");
+    // No reflection from the larger radius reaches the probe before T:
+    // measured 1.4e-5 (CI) and 1.3e-7 (full) against the peak 7.7e-2 /
+    // 4.1e-2; bound as pd_2d_notches.
+    check(e.ebf_large < 1e-3 * e.peak, "E15 (source's directions), larger R: probe agrees with the reference to < 1e-3 of its peak: " + sci(e.ebf_large));
     // The source's comparison (R = 42 "considerably better" than R = 26):
-    // measured ratio 1.0e2 (CI); asserted 10x as pd_2d_notches.
+    // measured ratio 1.0e2 (CI), 6.2e3 (full); asserted 10x as pd_2d_notches.
     check(e.ebf_large < 0.1 * e.ebf_small, "E15 (source's directions): error(larger R) < 0.1 error(smaller R): " + sci(e.ebf_large) + " vs " + sci(e.ebf_small));
-    // EBF vs first order at the smaller R. Measured (CI) probe 5.84x, field
-    // at T 45x. Asserted 4x / 20x: above what e15_parameters() reaches
-    // (2.3x / 3.4x), so a fall back to that level fails; below the
-    // measured values by a margin that covers round-off and compiler
-    // differences of these deterministic runs (the neighbouring settings of
-    // the scan give 5.3-6.7x / 41-49x).
+    // EBF vs first order at the smaller R (field: squared norms on
+    // r < R1 - delta). Measured probe 5.84x (CI) / 5.34x (full), field at T
+    // 45x / 14.8x. Asserted 4x and 20x (CI) / 10x (full): above what
+    // e15_parameters() reaches (2.3x / 4.3x probe, 3.4x / 7.5x field),
+    // so a fall back to that level fails; below the measured values by a
+    // margin for round-off and compiler differences of these deterministic
+    // runs (the neighbouring settings of the scan give 5.3-6.7x / 41-49x).
+    const double field_bound = full ? 10. : 20.;
     check(probe_ratio > 4., "E15 (source's directions), smaller R: probe error at least 4x below first order (" + sci(e.ebf_small) + " vs " + sci(e.first_order) + ")");
-    check(field_ratio > 20., "E15 (source's directions), smaller R: field error at T at least 20x below first order (" + sci(e.field_small) + " vs " + sci(e.field_first_order) + ")");
+    check(field_ratio > field_bound, "E15 (source's directions), smaller R: field error at T at least " + std::to_string(static_cast<int>(field_bound)) + "x below first order (" + sci(e.field_small) + " vs " + sci(e.field_first_order) + ")");
     if (!full && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
       {
         // One-step map of the R = 2.5 disc at dt = 0.02 and 0.005 (measured
-        // 1 - 5.2e-5 and 1 - RHO2).
+        // 1 - 5.2e-5 and 1 - 2.1e-5).
         for (const double dt : {0.02, 0.005})
           {
             unsigned int n_up = 0;
@@ -2307,8 +2313,8 @@ namespace
           }
         // The (4.99) energy of all nodes of the R = 13 disc from the rough
         // state, sampled every 100 steps over 5000 steps: every sample below
-        // the previous one (measured: none above; single steps rise at
-        // NUPS of 20,000, so steps are not compared one by one).
+        // the previous one (measured: largest change -4.4e-2; single steps
+        // rise at 43 of 20,000, so steps are not compared one by one).
         LatticeParameters    lp;
         ScalarWaveParameters mp;
         e15_model(lp, mp, 0.02);
