@@ -2336,7 +2336,7 @@ namespace
    * pi/4, d_inf = delta, full pseudo-inverse, value form). Keys: the EBF
    * keys of with_wave_settings (form, nphi, dphi, dk, nk, cone, cloud, tol,
    * reg, levels, disp, maxv, thin; curv > 0: curvature radius = the radius
-   * of each disc); radii=2.5,4 (one-step radius of these discs, 0: none),
+   * of each disc; wrel=f: wake curvature radius f R, with wk); radii=2.5,4 (one-step radius of these discs, 0: none),
    * dts=0.02,0.005 (their time steps); run=s (E15 at scale s: 0.5 the CI
    * size, 1 the source's; probe error over [0, T] and field error at T of
    * the EBF runs at both radii, first order and free at R1 with
@@ -2367,6 +2367,8 @@ namespace
         const auto              prm    = [&](const double R) {
           WaveAbcParameters q = base;
           q.curvature_radius  = curved ? R : 0.;
+          if (num("wrel", 0.) > 0.)
+            q.wake_curvature_radius = num("wrel", 0.) * R;
           return q;
         };
         std::cout << "  {" << item << "}" << std::endl;
