@@ -1195,7 +1195,6 @@ namespace
       }
   }
 
-
   // The one-step spectral radius diagnostic and the setup guard built on it.
   void
   spectral_radius()
@@ -2294,7 +2293,8 @@ namespace
     // e15_parameters() reaches (2.3x / 4.3x probe, 3.4x / 7.5x field),
     // so a fall back to that level fails; below the measured values by a
     // margin for round-off and compiler differences of these deterministic
-    // runs (the neighbouring settings of the scan give 5.3-6.7x / 41-49x).
+    // runs (the neighbours in cone, cloud, n_k, n_phi and Delta phi give
+    // 4.8-7.2x / 31-51x, CI).
     const double field_bound = full ? 10. : 20.;
     check(probe_ratio > 4., "E15 (source's directions), smaller R: probe error at least 4x below first order (" + sci(e.ebf_small) + " vs " + sci(e.first_order) + ")");
     check(field_ratio > field_bound, "E15 (source's directions), smaller R: field error at T at least " + std::to_string(static_cast<int>(field_bound)) + "x below first order (" + sci(e.field_small) + " vs " + sci(e.field_first_order) + ")");
@@ -2328,6 +2328,7 @@ namespace
         check(inc < 0., "E15 source's directions: energy from the rough state (R = 13) decreasing between samples every 100 steps over 5000 steps (largest change " + sci(inc) + ")");
       }
   }
+
   /**
    * Scan of EBF layer settings for E15 (m = 3; not a ctest: a tool for
    * doc/design.md, session 18). Does nothing unless E15_SCAN="key=value ...;
