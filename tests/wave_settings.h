@@ -27,7 +27,7 @@ namespace PeriDEALTests
     return kv;
   }
 
-  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk). */
+  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk, points, layer). */
   inline PeriDEAL::Abc::WaveAbcParameters
   with_wave_settings(PeriDEAL::Abc::WaveAbcParameters p, const std::map<std::string, std::string> &kv)
   {
@@ -51,6 +51,8 @@ namespace PeriDEALTests
     p.curvature_radius         = num("curv", p.curvature_radius);
     p.wake_curvature_radius    = num("wcurv", p.wake_curvature_radius);
     p.wake_wave_number         = num("wk", p.wake_wave_number);
+    p.cloud_points             = str("points", p.cloud_points);
+    p.layer_thickness          = num("layer", p.layer_thickness);
     return p;
   }
 
@@ -120,6 +122,33 @@ namespace PeriDEALTests
     prm.cloud_radius                  = 1.;
     prm.cone_angle                    = 0.4;
     prm.pseudo_inverse_tolerance      = 4e-4;
+    return prm;
+  }
+
+  /**
+   * E15 (2D PD waves, m = 3, doc/design.md, session 18) with the source's
+   * direction set: n_phi = 10 directions in [-pi/4, pi/4] about the normal
+   * (the defaults), made stable by session 14-15's regularization: the
+   * increment form, Tikhonov lambda = 1.5e-3 sigma_max, clouds of the points
+   * within 3.5 dx (0.875, the largest the ghost layer admits at m = 3) in
+   * the wide cone Delta phi = 0.4 (14-15 points), and two changes of the
+   * mode set: curved about x_i - R n (R: the disc radius) and wave numbers
+   * in [-2, 2] (Delta k = 2, n_k = 10). With Delta k = 1 (the source's) no
+   * lambda in 3e-5 .. 1e-2 is stable on the R = 2.5 disc; with plane modes
+   * the probe error is no better than the normal-only e15_parameters().
+   */
+  inline PeriDEAL::Abc::WaveAbcParameters
+  e15_source_modes_parameters(const double disc_radius)
+  {
+    PeriDEAL::Abc::WaveAbcParameters prm;
+    prm.dispersion                    = "discrete";
+    prm.curvature_radius              = disc_radius;
+    prm.wave_number_range             = 2.;
+    prm.cloud_radius                  = 0.875;
+    prm.cone_angle                    = 0.4;
+    prm.pseudo_inverse_tolerance      = 1.5e-3;
+    prm.pseudo_inverse_regularization = "tikhonov";
+    prm.fit_form                      = "increment";
     return prm;
   }
 } // namespace PeriDEALTests

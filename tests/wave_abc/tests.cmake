@@ -13,14 +13,14 @@ endif()
 foreach(_t dispersion updating_vectors spectral_radius semi_discrete sponge pml abc_skipped shared_vectors compact_levels pd_2d_stable)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS unit)
 endforeach()
-foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches)
+foreach(_t pd_1d_modes pd_2d fem_2d pd_1d_dispersive pd_2d_notches pd_2d_notches_source)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS convergence)
 endforeach()
 # E12c at the source's size (150,000 steps) and the EBF part of the
 # semi-discrete analysis (two dense 2D eigenproblems); the sponge over 1e6 steps;
 # E15 at the source's radii (26, 42; ~270k nodes in all); the stable m = 6
 # EBF layer over 1e6 steps.
-foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full)
+foreach(_t pd_1d_dispersive_full semi_discrete_ebf sponge_long pml_long pd_2d_notches_full pd_2d_notches_source_full)
   perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:wave_abc_tests> ${_t} LABELS long TIMEOUT 1200)
 endforeach()
 # E14 at the source's size (R = 26, t = 40 and 50; 80 s CPU).

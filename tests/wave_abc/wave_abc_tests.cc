@@ -953,6 +953,11 @@ namespace
     double ebf_small = 0., ebf_large = 0., first_order = 0., free = 0., peak = 0.;
     /** Max probe error of the small EBF run over (T, tmul T]. */
     double ebf_small_late = 0.;
+    /**
+     * Field errors at T: sum (u - u_ref)^2 over the nodes with r < R1 - delta
+     * / sum u0^2 there (EBF R1, EBF R2, first order R1, free R1).
+     */
+    double field_small = 0., field_large = 0., field_first_order = 0., field_free = 0.;
     std::uint64_t n_broken = 0;
     bool          same_bonds = true;
   };
@@ -992,7 +997,28 @@ namespace
    * the free truncation at the small radius.
    */
   NotchErrors
+  e15_notches(const std::function<WaveAbcParameters(double)> &parameters, const double scale, const double tmul = 1.,
+              const double dt = 0.02);
+
+  NotchErrors
   e15_notches(const WaveAbcParameters &prm, const double scale, const double tmul = 1., const double dt = 0.02)
+  {
+    return e15_notches([prm](double) { return prm; }, scale, tmul, dt);
+  }
+
+  /** The E15 layer setting (doc/design.md, session 11). */
+  WaveAbcParameters
+  e15_parameters();
+
+  /**
+   * As above with the EBF parameters of each disc, parameters(R) (e.g. a
+   * curvature radius equal to R). The first-order and free runs at R1 always
+   * take e15_parameters() (the first-order ABC reads the cone and cloud
+   * radius), so that every EBF setting is compared with the same baseline.
+   */
+  NotchErrors
+  e15_notches(const std::function<WaveAbcParameters(double)> &parameters, const double scale, const double tmul,
+              const double dt)
   {
     const double R1 = 26. * scale, R2 = 42. * scale, T = 50. * scale;
     LatticeParameters    lp;
@@ -1016,8 +1042,11 @@ namespace
     for (const auto &su : setups)
       {
         runs.emplace_back(std::make_unique<PdUnboundedWave<2>>(MPI_COMM_WORLD));
-        runs.back()->setup(BallDomain<2>(Point<2>(), su.first), lp, mp, su.second, prm, u0, notches);
+        runs.back()->setup(BallDomain<2>(Point<2>(), su.first), lp, mp, su.second,
+                           su.second == WaveTruncation::absorbing ? parameters(su.first) : e15_parameters(), u0, notches);
       }
+    const auto inner = [&](const Point<2> &p) { return p.norm() < R1 - lp.delta - 1e-9; };
+    const double norm0 = sum_squares(runs[0]->gather(inner));
     NotchErrors e;
     e.n_broken = runs[0]->n_broken_bonds();
     for (const auto &r : runs)
@@ -1039,6 +1068,13 @@ namespace
         e.peak = std::max(e.peak, std::abs(ur));
         for (unsigned int q = 1; q < runs.size(); ++q)
           err[q] = std::max(err[q], std::abs(runs[q]->value_at(probe) - ur));
+        if (s == n_steps)
+          {
+            const auto ref_field = runs[0]->gather(inner);
+            double    *field[]   = {nullptr, &e.field_small, &e.field_large, &e.field_first_order, &e.field_free};
+            for (unsigned int q = 1; q < runs.size(); ++q)
+              *field[q] = field_difference(runs[q]->gather(inner), ref_field, lp.dx) / norm0;
+          }
       }
     e.ebf_small   = err[1];
     e.ebf_large   = err[2];
@@ -1049,11 +1085,11 @@ namespace
                 << ": max |u - u_ref| at (" << probe << "): EBF R = " << R1 << " " << sci(e.ebf_small) << ", R = " << R2 << " "
                 << sci(e.ebf_large) << ", first-order R = " << R1 << " " << sci(e.first_order) << ", free " << sci(e.free)
                 << " (max |u_ref| there " << sci(e.peak) << ")" << (tmul > 1. ? ", EBF R1 after T " + sci(e.ebf_small_late) : "")
-                << std::endl;
+                << "; field error at T on r < R1 - delta: EBF R1 " << sci(e.field_small) << ", R2 " << sci(e.field_large)
+                << ", first-order " << sci(e.field_first_order) << ", free " << sci(e.field_free) << std::endl;
     return e;
   }
 
-  /** The E15 layer setting (doc/design.md, session 11). */
   WaveAbcParameters
   e15_parameters()
   {
@@ -2305,6 +2341,199 @@ namespace
       }
   }
 
+  // E15 with the source's direction set (doc/design.md, session 18):
+  // e15_source_modes_parameters(), n_phi = 10 directions in [-pi/4, pi/4]
+  // about the normal, stable with the increment form, Tikhonov lambda =
+  // 1.5e-3 sigma_max, 3.5 dx clouds in the wide cone 0.4, curved modes and
+  // Delta k = 2. CI halved as pd_2d_notches; the first-order and free runs
+  // take e15_parameters() (the same baseline as pd_2d_notches).
+  void
+  pd_2d_notches_source(const bool full)
+  {
+    const NotchErrors e = e15_notches(e15_source_modes_parameters, full ? 1. : 0.5);
+    const double      probe_ratio = e.first_order / e.ebf_small, field_ratio = e.field_first_order / e.field_small;
+    if (root())
+      std::cout << "    source's directions: first order / EBF at R1: probe " << probe_ratio << ", field at T " << field_ratio
+                << std::endl;
+    check(e.n_broken > 0 && e.same_bonds, "notches break the same bonds in every near field");
+    // No reflection from the larger radius reaches the probe before T:
+    // measured 1.4e-5 (CI) and 1.3e-7 (full) against the peak 7.7e-2 /
+    // 4.1e-2; bound as pd_2d_notches.
+    check(e.ebf_large < 1e-3 * e.peak, "E15 (source's directions), larger R: probe agrees with the reference to < 1e-3 of its peak: " + sci(e.ebf_large));
+    // The source's comparison (R = 42 "considerably better" than R = 26):
+    // measured ratio 1.0e2 (CI), 6.2e3 (full); asserted 10x as pd_2d_notches.
+    check(e.ebf_large < 0.1 * e.ebf_small, "E15 (source's directions): error(larger R) < 0.1 error(smaller R): " + sci(e.ebf_large) + " vs " + sci(e.ebf_small));
+    // EBF vs first order at the smaller R (field: squared norms on
+    // r < R1 - delta). Measured probe 5.84x (CI) / 5.34x (full), field at T
+    // 45x / 14.8x. Asserted 4x and 20x (CI) / 10x (full): above what
+    // e15_parameters() reaches (2.3x / 4.3x probe, 3.4x / 7.5x field),
+    // so a fall back to that level fails; below the measured values by a
+    // margin for round-off and compiler differences of these deterministic
+    // runs (the neighbours in cone, cloud, n_k, n_phi and Delta phi give
+    // 4.8-7.2x / 31-51x, CI).
+    const double field_bound = full ? 10. : 20.;
+    check(probe_ratio > 4., "E15 (source's directions), smaller R: probe error at least 4x below first order (" + sci(e.ebf_small) + " vs " + sci(e.first_order) + ")");
+    check(field_ratio > field_bound, "E15 (source's directions), smaller R: field error at T at least " + std::to_string(static_cast<int>(field_bound)) + "x below first order (" + sci(e.field_small) + " vs " + sci(e.field_first_order) + ")");
+    if (!full && Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
+      {
+        // One-step map of the R = 2.5 disc at dt = 0.02 and 0.005 (measured
+        // 1 - 5.2e-5 and 1 - 2.1e-5).
+        for (const double dt : {0.02, 0.005})
+          {
+            unsigned int n_up = 0;
+            const double rho  = radius_2d(2.5, e15_source_modes_parameters(2.5), 0.25, 3, &n_up, nullptr, nullptr, nullptr,
+                                         WaveTruncation::absorbing, dt);
+            std::cout << "    source's directions, m = 3, R = 2.5, dt = " << dt << ": rho - 1 = " << sci(rho - 1.) << " ("
+                      << n_up << " eigenvalues > 1 + 1e-8)" << std::endl;
+            check(rho <= 1. + 1e-8, "E15 source's directions: one-step spectral radius <= 1 + 1e-8 (m = 3, R = 2.5, dt = " + std::to_string(dt) + ")");
+          }
+        // The (4.99) energy of all nodes of the R = 13 disc from the rough
+        // state, sampled every 100 steps over 5000 steps: every sample below
+        // the previous one (measured: largest change -4.4e-2; single steps
+        // rise at 43 of 20,000, so steps are not compared one by one).
+        LatticeParameters    lp;
+        ScalarWaveParameters mp;
+        e15_model(lp, mp, 0.02);
+        PdUnboundedWave<2> pd(MPI_COMM_SELF);
+        pd.setup(BallDomain<2>(Point<2>(), 13.), lp, mp, WaveTruncation::absorbing, e15_source_modes_parameters(13.),
+                 rough_state());
+        const std::vector<double> energy = sampled_energy(pd, 5000, 50);
+        const double              inc    = max_relative_increase(energy);
+        std::cout << "    source's directions, R = 13, rough state, 5000 steps: E_end/E0 " << sci(energy.back() / energy[0])
+                  << ", largest change between 100-step samples " << sci(inc) << std::endl;
+        check(inc < 0., "E15 source's directions: energy from the rough state (R = 13) decreasing between samples every 100 steps over 5000 steps (largest change " + sci(inc) + ")");
+      }
+  }
+
+  /**
+   * Scan of EBF layer settings for E15 (m = 3; not a ctest: a tool for
+   * doc/design.md, session 18). Does nothing unless E15_SCAN="key=value ...;
+   * ..." is set; one setting per ';'-separated item, each on top of the
+   * source's layer (WaveAbcParameters(): n_phi 10, Delta phi pi/4, cone
+   * pi/4, d_inf = delta, full pseudo-inverse, value form). Keys: the EBF
+   * keys of with_wave_settings (form, nphi, dphi, dk, nk, cone, cloud, tol,
+   * reg, levels, disp, maxv, thin; curv > 0: curvature radius = the radius
+   * of each disc; wrel=f: wake curvature radius f R, with wk); radii=2.5,4 (one-step radius of these discs, 0: none),
+   * dts=0.02,0.005 (their time steps); run=s (E15 at scale s: 0.5 the CI
+   * size, 1 the source's; probe error over [0, T] and field error at T of
+   * the EBF runs at both radii, first order and free at R1 with
+   * e15_parameters()), tmul (run to tmul T), rdt (time step of the run,
+   * 0.02); trans=n (the (4.99) energy of all nodes from rough_state() at
+   * every one of n steps on the disc long_R, default 13: peak, rises between
+   * steps and between samples every N steps).
+   */
+  void
+  e15_scan()
+  {
+    const char *env = std::getenv("E15_SCAN");
+    if (!env)
+      return;
+    std::istringstream in(env);
+    std::string        item;
+    while (std::getline(in, item, ';'))
+      {
+        const auto kv  = key_values(item);
+        const auto num = [&](const std::string &k, const double dflt) { return kv.count(k) ? std::stod(kv.at(k)) : dflt; };
+        const auto list = [&](const std::string &k, const std::string &dflt) {
+          std::string l = kv.count(k) ? kv.at(k) : dflt;
+          std::replace(l.begin(), l.end(), ',', ' ');
+          return l;
+        };
+        const WaveAbcParameters base   = with_wave_settings(WaveAbcParameters(), kv);
+        const bool              curved = base.curvature_radius > 0.;
+        const auto              prm    = [&](const double R) {
+          WaveAbcParameters q = base;
+          q.curvature_radius  = curved ? R : 0.;
+          if (num("wrel", 0.) > 0.)
+            q.wake_curvature_radius = num("wrel", 0.) * R;
+          return q;
+        };
+        std::cout << "  {" << item << "}" << std::endl;
+        std::istringstream radii(list("radii", "2.5"));
+        double             Rd = 0.;
+        while (radii >> Rd && Rd > 0.)
+          {
+            std::istringstream dts(list("dts", "0.02"));
+            double             dt = 0.;
+            while (dts >> dt)
+              try
+                {
+                  Timer               timer;
+                  unsigned int        n_up = 0;
+                  WaveCloudStatistics st;
+                  const double r = radius_2d(Rd, prm(Rd), 0.25, 3, &n_up, &st, nullptr, nullptr, WaveTruncation::absorbing, dt);
+                  std::cout << "    R " << Rd << " dt " << dt << ": rho - 1 = " << sci(r - 1.) << " (" << n_up
+                            << " > 1 + 1e-8), clouds " << st.min_cloud_size << ".." << st.max_cloud_size << " thinned "
+                            << st.n_thinned << "/" << st.n_absorbing << " cond " << sci(st.max_condition_number)
+                            << " max|V| " << sci(st.max_update_norm) << " (" << sci(timer.cpu_time()) << " s)" << std::endl;
+                }
+              catch (const std::exception &e)
+                {
+                  std::cout << "    R " << Rd << " dt " << dt << ": setup failed: " << std::string(e.what()).substr(0, 300)
+                            << std::endl;
+                }
+          }
+        if (num("run", 0.) > 0.)
+          try
+            {
+              Timer             timer;
+              const NotchErrors e = e15_notches(prm, num("run", 0.), num("tmul", 1.), num("rdt", 0.02));
+              std::cout << "    E15 scale " << num("run", 0.) << " (" << sci(timer.cpu_time()) << " s): probe EBF R1 "
+                        << sci(e.ebf_small) << " (first order / EBF " << e.first_order / e.ebf_small << "), R2 "
+                        << sci(e.ebf_large) << "; field at T EBF R1 " << sci(e.field_small) << " (first order / EBF "
+                        << e.field_first_order / e.field_small << "), R2 " << sci(e.field_large) << std::endl;
+            }
+          catch (const std::exception &ex)
+            {
+              std::cout << "    E15 run: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
+            }
+        if (num("trans", 0.) > 0.)
+          try
+            {
+              LatticeParameters    lp;
+              ScalarWaveParameters mp;
+              e15_model(lp, mp, num("rdt", 0.02));
+              const double       Rl = num("long_R", 13.);
+              PdUnboundedWave<2> pd(MPI_COMM_SELF);
+              pd.setup(BallDomain<2>(Point<2>(), Rl), lp, mp, WaveTruncation::absorbing, prm(Rl), rough_state());
+              const auto          all = [](const Point<2> &) { return true; };
+              const unsigned long n   = static_cast<unsigned long>(num("trans", 0.));
+              std::vector<double> e{pd.energy(all)};
+              unsigned long       n_up = 0, first_up = 0, peak_step = 0;
+              double              max_rel = -1.;
+              for (unsigned long s = 1; s <= n; ++s)
+                {
+                  pd.advance();
+                  e.push_back(pd.energy(all));
+                  if (e[s] > e[s - 1])
+                    {
+                      ++n_up;
+                      first_up = first_up ? first_up : s;
+                      max_rel  = std::max(max_rel, e[s] / e[s - 1] - 1.);
+                    }
+                  if (e[s] > e[peak_step])
+                    peak_step = s;
+                }
+              std::cout << "    rough state R = " << Rl << ", " << n << " steps: peak E/E0 " << sci(e[peak_step] / e[0])
+                        << " at step " << peak_step << ", E_end/E0 " << sci(e.back() / e[0]) << ", steps with E up " << n_up
+                        << " (first " << first_up << ", largest " << sci(max_rel) << "); samples every N from 0 up:";
+              for (const unsigned long every : {10ul, 100ul, 1000ul})
+                if (every <= n / 2)
+                  {
+                    unsigned int ups = 0;
+                    for (unsigned long s = every; s <= n; s += every)
+                      ups += e[s] > e[s - every];
+                    std::cout << " " << every << ":" << ups;
+                  }
+              std::cout << std::endl;
+            }
+          catch (const std::exception &ex)
+            {
+              std::cout << "    rough state: setup failed: " << std::string(ex.what()).substr(0, 300) << std::endl;
+            }
+      }
+  }
+
 } // namespace
 
 int
@@ -2324,6 +2553,8 @@ main(int argc, char **argv)
               {"pd_1d_dispersive_full", [] { pd_1d_dispersive(true); }},
               {"pd_2d_notches", [] { pd_2d_notches(false); }},
               {"pd_2d_notches_full", [] { pd_2d_notches(true); }},
+              {"pd_2d_notches_source", [] { pd_2d_notches_source(false); }},
+              {"pd_2d_notches_source_full", [] { pd_2d_notches_source(true); }},
               {"sponge", sponge},
               {"abc_skipped", abc_skipped},
               {"shared_vectors", shared_vectors},
@@ -2335,5 +2566,6 @@ main(int argc, char **argv)
               {"pd_2d_stable", [] { pd_2d_stable(false); }},
               {"pd_2d_stable_long", [] { pd_2d_stable(true); }},
               {"pd_2d_source_size", pd_2d_source_size},
-              {"e14_scan", e14_scan}});
+              {"e14_scan", e14_scan},
+              {"e15_scan", e15_scan}});
 }
