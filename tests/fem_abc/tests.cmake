@@ -33,3 +33,5 @@ perideal_add_test(NAME fem_abc.newmark_wake_stability COMMAND $<TARGET_FILE:fem_
 perideal_add_test(NAME fem_abc.newmark_e13_wake COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake LABELS convergence TIMEOUT 1200)
 # E13 at the source's size with the source's mode set (Newmark + consistent mass).
 perideal_add_test(NAME fem_abc.newmark_e13_source_size COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_source_size LABELS convergence TIMEOUT 1200)
+# FE_Q(2) + EBF with Newmark + consistent mass: one-step radius and energy decay.
+perideal_add_test(NAME fem_abc.newmark_q2_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_q2_stability LABELS unit)
