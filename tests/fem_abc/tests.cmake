@@ -31,3 +31,7 @@ perideal_add_test(NAME fem_abc.newmark_e13_tikhonov COMMAND $<TARGET_FILE:fem_ab
 # energy decay: unit; E13 ratios: 22-40 s, in CI as the option's accuracy test).
 perideal_add_test(NAME fem_abc.newmark_wake_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_wake_stability LABELS unit)
 perideal_add_test(NAME fem_abc.newmark_e13_wake COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake LABELS convergence TIMEOUT 1200)
+# Session 18: the per-node wake radius 40 cos(theta)^3 (radius and energy
+# decay: unit; E13 ratios, the issue's 10x in the field: ~12-25 s, in CI).
+perideal_add_test(NAME fem_abc.newmark_wake_angle_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_wake_angle_stability LABELS unit)
+perideal_add_test(NAME fem_abc.newmark_e13_wake_angle COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake_angle LABELS convergence TIMEOUT 1200)
