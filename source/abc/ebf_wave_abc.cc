@@ -108,6 +108,14 @@ namespace PeriDEAL
                         "2D: curvature radius of the harmonic modes with |k| <= Wake wave number (0: Curvature radius for all).");
       prm.declare_entry("Wake wave number", "0", Patterns::Double(0.),
                         "Largest |k| of the modes that get the Wake curvature radius.");
+      prm.declare_entry("Wake angle exponent", "0", Patterns::Double(),
+                        "2D: p of the per-node wake radius Wake curvature radius * cos(theta)^p, theta "
+                        "between the normal and the direction from the centroid of the absorbing nodes (0: one radius).");
+      prm.declare_entry("Fit weight", "1", Patterns::Double(0.),
+                        "W of the weighted fit V = (Psi D)(M D)^+, D_c = 1 + (W - 1) exp(-(|k_c|/k_W)^2) "
+                        "(1: unweighted, the source; > 1: the slow modes are fitted more closely).");
+      prm.declare_entry("Fit weight wave number", "0", Patterns::Double(0.),
+                        "k_W of the fit weight profile (> 0 when Fit weight != 1).");
       prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge|pml"),
                         "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), "
                         "only the damping sponge (PD: nothing overwritten, energy-stable), or the "
@@ -162,6 +170,9 @@ namespace PeriDEAL
       curvature_radius         = prm.get_double("Curvature radius");
       wake_curvature_radius    = prm.get_double("Wake curvature radius");
       wake_wave_number         = prm.get_double("Wake wave number");
+      wake_angle_exponent      = prm.get_double("Wake angle exponent");
+      fit_weight               = prm.get_double("Fit weight");
+      fit_weight_wave_number   = prm.get_double("Fit weight wave number");
       method                   = prm.get("Method");
       sponge_damping           = prm.get_double("Sponge damping");
       sponge_thickness         = prm.get_double("Sponge thickness");
@@ -322,8 +333,16 @@ namespace PeriDEAL
       };
 
       Fit
-      fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false)
+      fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false,
+          const Eigen::VectorXd &weights = Eigen::VectorXd())
       {
+        // Weighted fit: V = (Psi D) (M D)^+ is the least-squares fit with the
+        // mode residuals weighted by D (same rank and condition guards, on M D).
+        if (weights.size() > 0)
+          {
+            const Eigen::VectorXcd d = weights.cast<std::complex<double>>();
+            return fit(M * d.asDiagonal(), psi * d.asDiagonal(), tolerance, tikhonov);
+          }
         // One SVD gives both the Moore-Penrose inverse and the condition
         // number. Without a tolerance, Eigen's default rank threshold
         // (max(rows, cols) * epsilon relative to sigma_max) is used.
@@ -381,6 +400,29 @@ namespace PeriDEAL
       check_parameter(prm.wake_curvature_radius == 0. || prm.wake_curvature_radius > prm.cloud_radius,
                       "Absorbing boundary/Wake curvature radius", prm.wake_curvature_radius,
                       "0 or > the cloud radius " + std::to_string(prm.cloud_radius));
+      check_parameter(prm.fit_weight > 0., "Absorbing boundary/Fit weight", prm.fit_weight, "> 0 (1: unweighted)");
+      check_parameter(prm.fit_weight == 1. || prm.fit_weight_wave_number > 0.,
+                      "Absorbing boundary/Fit weight wave number", prm.fit_weight_wave_number,
+                      "> 0 when Fit weight != 1");
+      check_parameter(prm.wake_angle_exponent == 0. || (dim == 2 && prm.wake_curvature_radius > 0.),
+                      "Absorbing boundary/Wake angle exponent", prm.wake_angle_exponent,
+                      "0 unless 2D with a Wake curvature radius > 0");
+      // Centroid of the absorbing nodes (all ranks) for the per-node wake radius.
+      Point<dim> wake_centre;
+      if (prm.wake_angle_exponent != 0.)
+        {
+          std::vector<double> sum(dim + 1, 0.);
+          for (const unsigned int i : absorbing_in)
+            {
+              for (unsigned int d = 0; d < dim; ++d)
+                sum[d] += points[i][d];
+              sum[dim] += 1.;
+            }
+          for (double &x : sum)
+            x = Utilities::MPI::sum(x, comm);
+          for (unsigned int d = 0; d < dim; ++d)
+            wake_centre[d] = sum[d] / std::max(sum[dim], 1.);
+        }
       absorbing = absorbing_in;
       cloud_start.assign(1, 0);
       cloud_index.clear();
@@ -506,6 +548,24 @@ namespace PeriDEAL
           const double rho_all = dim == 2 ? prm.curvature_radius : 0.;
           // Wake curvature: the harmonic modes with |k| <= the wake wave
           // number get the radius wake_curvature_radius instead (empty: off).
+          double rho_wake = prm.wake_curvature_radius;
+          if (prm.wake_angle_exponent != 0.)
+            {
+              // cos theta between the normal and the direction from the centroid.
+              const Tensor<1, dim> from_c    = xi - wake_centre;
+              const double         cos_theta = from_c.norm() > 0. ?
+                                                 (normals[a] * from_c) / (normals[a].norm() * from_c.norm()) :
+                                                 1.;
+              rho_wake = cos_theta > 0. ? prm.wake_curvature_radius * std::pow(cos_theta, prm.wake_angle_exponent) : 0.;
+              check_parameter(rho_wake > prm.cloud_radius, "Absorbing boundary/Wake angle exponent",
+                              prm.wake_angle_exponent,
+                              "a value with Wake curvature radius * cos(theta)^p > the cloud radius at absorbing node " +
+                                std::to_string(ids[i]) + " (cos theta = " + std::to_string(cos_theta) + ")");
+              // The class key of store_updating_vectors() must tell the radii apart.
+              std::array<double, dim + 3> m{};
+              m[0] = rho_wake;
+              node_modes[a].push_back(m);
+            }
           std::vector<bool> low_k;
           if (dim == 2 && prm.wake_curvature_radius > 0.)
             for (unsigned int c = 0; c < n_all; ++c)
@@ -514,7 +574,7 @@ namespace PeriDEAL
             const std::complex<double> I(0., 1.);
             Tensor<1, dim>             s         = xbar;
             double                     amplitude = 1.;
-            const double               rho       = c < low_k.size() && low_k[c] ? prm.wake_curvature_radius : rho_all;
+            const double               rho       = c < low_k.size() && low_k[c] ? rho_wake : rho_all;
             if (rho > 0.)
               {
                 Tensor<1, dim> from_centre = xbar;
@@ -526,6 +586,17 @@ namespace PeriDEAL
               }
             return amplitude * std::exp(-decay[c] * time + I * (kvec[c] * s) - I * omega[c] * time);
           };
+          // Column weights of the weighted fit (empty: unweighted).
+          Eigen::VectorXd weights;
+          if (prm.fit_weight != 1.)
+            {
+              weights = Eigen::VectorXd::Ones(n_all);
+              for (unsigned int c = 0; c < n_modes; ++c)
+                {
+                  const double q = kvec[c].norm() / prm.fit_weight_wave_number;
+                  weights[c]     = 1. + (prm.fit_weight - 1.) * std::exp(-q * q);
+                }
+            }
           const auto mode_rate = [&](const unsigned int c) {
             return -decay[c] - std::complex<double>(0., 1.) * omega[c];
           };
@@ -719,8 +790,8 @@ namespace PeriDEAL
                         MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
                       }
                 }
-              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
-              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
+              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov, weights);
+              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov, weights);
               if (increment)
                 {
                   // + e_i: cloud[0] = x_i, row 0 = level n.

@@ -461,6 +461,24 @@ namespace
     check(rejected([](E13 &c) { c.abc.wake_curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing,
                    "Wake curvature radius"),
           "Wake curvature radius below the cloud radius rejected naming Absorbing boundary/Wake curvature radius");
+    // The per-node wake radius (session 18) needs a wake radius and, at
+    // every node, a radius outside the cloud (on the (-1, 1)^2 mesh of
+    // rejected(): 40 cos(26.6 deg)^40 = 0.46 < 1 at the edge node (1, 0.5)).
+    check(rejected([](E13 &c) { c.abc.wake_angle_exponent = 3.; }, Fem::WaveBoundary::absorbing,
+                   "Wake angle exponent"),
+          "Wake angle exponent without a wake radius rejected naming Absorbing boundary/Wake angle exponent");
+    check(rejected(
+            [](E13 &c) {
+              c.abc.wake_curvature_radius = 40.;
+              c.abc.wake_angle_exponent   = 40.;
+            },
+            Fem::WaveBoundary::absorbing, "Wake angle exponent"),
+          "Wake angle exponent with radii inside the cloud rejected naming Absorbing boundary/Wake angle exponent");
+    // The weighted fit: W > 0, and k_W > 0 when W != 1.
+    check(rejected([](E13 &c) { c.abc.fit_weight = 0.; }, Fem::WaveBoundary::absorbing, "Fit weight"),
+          "Fit weight 0 rejected naming Absorbing boundary/Fit weight");
+    check(rejected([](E13 &c) { c.abc.fit_weight = 3.; }, Fem::WaveBoundary::absorbing, "Fit weight wave number"),
+          "Fit weight without its wave number rejected naming Absorbing boundary/Fit weight wave number");
   }
   /**
    * Backward Euler diffusion with the EBF ABC on (-1, 1)^2, h = 0.125, Q1
@@ -811,6 +829,49 @@ namespace
                                                " at least 10x below first-order " + sci(r.probe_first));
     check(10. * r.final_ebf < r.final_first, "source size: field at t_end EBF " + sci(r.final_ebf) +
                                                " at least 10x below first-order " + sci(r.final_first));
+  }
+
+  /**
+   * Session 18: newmark_wake_curvature() with a per-node wake radius
+   * 40 cos(theta)^3 (Absorbing boundary/Wake angle exponent 3; theta
+   * between the normal and the direction from the centre): the edge nodes
+   * near the corners (theta ~ 45 degrees), where the wake arrives obliquely,
+   * get radii down to 14, the edge centres and the corner DoFs 40.
+   */
+  E13
+  newmark_wake_angle()
+  {
+    E13 c                       = newmark_wake_curvature();
+    c.abc.wake_curvature_radius = 40.;
+    c.abc.wake_angle_exponent   = 3.;
+    return c;
+  }
+
+  /** One-step radius on (-3, 3)^2 and energy decay over 2e4 steps (energy_decay) of newmark_wake_angle(). */
+  void
+  newmark_wake_angle_stability()
+  {
+    const E13    c   = newmark_wake_angle();
+    const double rho = radius(Fem::WaveBoundary::absorbing, 0., 1, "Newmark", false, c);
+    // Measured 1 + 4.6e-8 (dominant -1): the round-off split of the
+    // defective -1 of the prescribed-velocity recursion, as in
+    // newmark_wake_stability.
+    check(rho < 1. + 1e-6, "Newmark + curved EBF, wake radius 40 cos^3: radius 1 + " + sci(rho - 1.) + " < 1 + 1e-6");
+    energy_decay(c, 20000, 100);
+  }
+
+  /** E13 with newmark_wake_angle(): the 10x in energy, probe and field. */
+  void
+  newmark_e13_wake_angle()
+  {
+    const E13Result r = run_e13(newmark_wake_angle(), true);
+    // Measured: energy 4.01e-4 vs 5.27e-3 (13.2x), probe 1.77e-4 vs
+    // 7.13e-3 (40x), field at t_end 6.77e-4 vs 8.60e-3 (12.7x). Asserted:
+    // the 10x in energy and field (margins 32 % and 27 %), probe 30x
+    // (25 % below measured). With one wake radius (newmark_e13_wake) the
+    // field is 9.79x, so the field check fails if the per-node radius stops
+    // acting.
+    check_e13_ratios(r, "Newmark consistent, curved modes, wake radius 40 cos^3: ", 10., 30., 10.);
   }
 
   void
@@ -1424,5 +1485,5 @@ namespace
 int
 main(int argc, char **argv)
 {
-  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"newmark_tikhonov_stability", newmark_tikhonov_stability}, {"newmark_e13_tikhonov", newmark_e13_tikhonov}, {"newmark_tikhonov_long", newmark_tikhonov_long}, {"newmark_wake_stability", newmark_wake_stability}, {"newmark_e13_wake", newmark_e13_wake}, {"newmark_e13_source_size", newmark_e13_source_size}, {"newmark_q2_stability", newmark_q2_stability}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
+  return run(argc, argv, {{"backward_euler_guard", backward_euler_guard}, {"newmark_energy_decay_short", newmark_energy_decay_short}, {"newmark_energy_decay_long", newmark_energy_decay_long}, {"verlet_energy_decay_short", verlet_energy_decay_short}, {"verlet_energy_decay_long", verlet_energy_decay_long}, {"verlet_layer_spectral_radius", verlet_layer_spectral_radius}, {"e13", e13}, {"e13_curved", e13_curved}, {"e13_verlet_layer", e13_verlet_layer}, {"constant_state", constant_state}, {"bad_input", bad_input}, {"spectral_radius", spectral_radius}, {"newmark_spectral_radius", newmark_spectral_radius}, {"newmark_e13", newmark_e13}, {"newmark_e13_curved", newmark_e13_curved}, {"newmark_curved_stability", newmark_curved_stability}, {"newmark_tikhonov_stability", newmark_tikhonov_stability}, {"newmark_e13_tikhonov", newmark_e13_tikhonov}, {"newmark_tikhonov_long", newmark_tikhonov_long}, {"newmark_wake_stability", newmark_wake_stability}, {"newmark_e13_wake", newmark_e13_wake}, {"newmark_e13_source_size", newmark_e13_source_size}, {"newmark_q2_stability", newmark_q2_stability}, {"newmark_wake_angle_stability", newmark_wake_angle_stability}, {"newmark_e13_wake_angle", newmark_e13_wake_angle}, {"e13_scan", e13_scan}, {"mode_scan", mode_scan}, {"half_derivative", half_derivative}, {"half_derivative_soe", half_derivative_soe}, {"diffusion_parameters", diffusion_parameters}});
 }

@@ -35,3 +35,7 @@ perideal_add_test(NAME fem_abc.newmark_e13_wake COMMAND $<TARGET_FILE:fem_abc_te
 perideal_add_test(NAME fem_abc.newmark_e13_source_size COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_source_size LABELS convergence TIMEOUT 1200)
 # FE_Q(2) + EBF with Newmark + consistent mass: one-step radius and energy decay.
 perideal_add_test(NAME fem_abc.newmark_q2_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_q2_stability LABELS unit)
+# Session 18: the per-node wake radius 40 cos(theta)^3 (radius and energy
+# decay: unit; E13 ratios, the issue's 10x in the field: ~12-25 s, in CI).
+perideal_add_test(NAME fem_abc.newmark_wake_angle_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_wake_angle_stability LABELS unit)
+perideal_add_test(NAME fem_abc.newmark_e13_wake_angle COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake_angle LABELS convergence TIMEOUT 1200)

@@ -152,6 +152,29 @@ namespace PeriDEAL
       /** Largest |k| of the modes with the wake curvature radius. */
       double wake_wave_number = 0.;
       /**
+       * 2D, with wake_curvature_radius > 0: exponent p of a per-node wake
+       * radius rho_w cos(theta_i)^p, theta_i the angle between the node's
+       * outward normal and x_i - c (c: the centroid of the absorbing nodes,
+       * e.g. the centre of a square near field). A wake from the centre meets
+       * the edge nodes near a corner obliquely (theta up to 45 degrees); its
+       * one-way decay (u_t + chi u_n) / u grows there, i.e. it needs a smaller
+       * radius than at the edge centres. 0 (the default): one radius.
+       */
+      double wake_angle_exponent = 0.;
+      /**
+       * Weighted fit (1, the default: off, the unweighted fit bitwise
+       * unchanged). The updating vectors V = Psi M^+ are the least-squares
+       * fit over the modes (columns of M, ~190 for 5-6 cloud points); with
+       * a weight W != 1 they become V = (Psi D) (M D)^+ with the column
+       * weights D_c = 1 + (W - 1) exp(-(|k_c| / k_W)^2) (k_W:
+       * fit_weight_wave_number) of the harmonic modes (lattice modes 1):
+       * W > 1 makes the fit represent the slow (small |k|) modes, e.g. the
+       * 2D wake behind the front, more closely at the cost of the others.
+       */
+      double fit_weight = 1.;
+      /** k_W of the fit weight profile (> 0 when fit_weight != 1). */
+      double fit_weight_wave_number = 0.;
+      /**
        * "ebf" (the EBF extrapolation (4.82)) or "first order": the
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone
