@@ -27,7 +27,7 @@ namespace PeriDEALTests
     return kv;
   }
 
-  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk, points, layer, wp, share, fw, fwk). */
+  /** @p p with the EBF keys of @p kv applied (form, nphi, dphi, dk, nk, cone, cloud, tol, reg, levels, disp, maxv, thin, curv, wcurv, wk, points, layer, wp, share). */
   inline PeriDEAL::Abc::WaveAbcParameters
   with_wave_settings(PeriDEAL::Abc::WaveAbcParameters p, const std::map<std::string, std::string> &kv)
   {
@@ -55,8 +55,6 @@ namespace PeriDEALTests
     p.layer_thickness          = num("layer", p.layer_thickness);
     p.wake_angle_exponent      = num("wp", p.wake_angle_exponent);
     p.share_updating_vectors   = num("share", p.share_updating_vectors ? 1. : 0.) != 0.;
-    p.fit_weight               = num("fw", p.fit_weight);
-    p.fit_weight_wave_number   = num("fwk", p.fit_weight_wave_number);
     return p;
   }
 

@@ -111,11 +111,6 @@ namespace PeriDEAL
       prm.declare_entry("Wake angle exponent", "0", Patterns::Double(),
                         "2D: p of the per-node wake radius Wake curvature radius * cos(theta)^p, theta "
                         "between the normal and the direction from the centroid of the absorbing nodes (0: one radius).");
-      prm.declare_entry("Fit weight", "1", Patterns::Double(0.),
-                        "W of the weighted fit V = (Psi D)(M D)^+, D_c = 1 + (W - 1) exp(-(|k_c|/k_W)^2) "
-                        "(1: unweighted, the source; > 1: the slow modes are fitted more closely).");
-      prm.declare_entry("Fit weight wave number", "0", Patterns::Double(0.),
-                        "k_W of the fit weight profile (> 0 when Fit weight != 1).");
       prm.declare_entry("Method", "ebf", Patterns::Selection("ebf|first order|sponge|pml"),
                         "The EBF extrapolation (4.82), the conventional first-order ABC (4.75), "
                         "only the damping sponge (PD: nothing overwritten, energy-stable), or the "
@@ -171,8 +166,6 @@ namespace PeriDEAL
       wake_curvature_radius    = prm.get_double("Wake curvature radius");
       wake_wave_number         = prm.get_double("Wake wave number");
       wake_angle_exponent      = prm.get_double("Wake angle exponent");
-      fit_weight               = prm.get_double("Fit weight");
-      fit_weight_wave_number   = prm.get_double("Fit weight wave number");
       method                   = prm.get("Method");
       sponge_damping           = prm.get_double("Sponge damping");
       sponge_thickness         = prm.get_double("Sponge thickness");
@@ -333,16 +326,8 @@ namespace PeriDEAL
       };
 
       Fit
-      fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false,
-          const Eigen::VectorXd &weights = Eigen::VectorXd())
+      fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false)
       {
-        // Weighted fit: V = (Psi D) (M D)^+ is the least-squares fit with the
-        // mode residuals weighted by D (same rank and condition guards, on M D).
-        if (weights.size() > 0)
-          {
-            const Eigen::VectorXcd d = weights.cast<std::complex<double>>();
-            return fit(M * d.asDiagonal(), psi * d.asDiagonal(), tolerance, tikhonov);
-          }
         // One SVD gives both the Moore-Penrose inverse and the condition
         // number. Without a tolerance, Eigen's default rank threshold
         // (max(rows, cols) * epsilon relative to sigma_max) is used.
@@ -400,10 +385,6 @@ namespace PeriDEAL
       check_parameter(prm.wake_curvature_radius == 0. || prm.wake_curvature_radius > prm.cloud_radius,
                       "Absorbing boundary/Wake curvature radius", prm.wake_curvature_radius,
                       "0 or > the cloud radius " + std::to_string(prm.cloud_radius));
-      check_parameter(prm.fit_weight > 0., "Absorbing boundary/Fit weight", prm.fit_weight, "> 0 (1: unweighted)");
-      check_parameter(prm.fit_weight == 1. || prm.fit_weight_wave_number > 0.,
-                      "Absorbing boundary/Fit weight wave number", prm.fit_weight_wave_number,
-                      "> 0 when Fit weight != 1");
       check_parameter(prm.wake_angle_exponent == 0. || (dim == 2 && prm.wake_curvature_radius > 0.),
                       "Absorbing boundary/Wake angle exponent", prm.wake_angle_exponent,
                       "0 unless 2D with a Wake curvature radius > 0");
@@ -586,17 +567,6 @@ namespace PeriDEAL
               }
             return amplitude * std::exp(-decay[c] * time + I * (kvec[c] * s) - I * omega[c] * time);
           };
-          // Column weights of the weighted fit (empty: unweighted).
-          Eigen::VectorXd weights;
-          if (prm.fit_weight != 1.)
-            {
-              weights = Eigen::VectorXd::Ones(n_all);
-              for (unsigned int c = 0; c < n_modes; ++c)
-                {
-                  const double q = kvec[c].norm() / prm.fit_weight_wave_number;
-                  weights[c]     = 1. + (prm.fit_weight - 1.) * std::exp(-q * q);
-                }
-            }
           const auto mode_rate = [&](const unsigned int c) {
             return -decay[c] - std::complex<double>(0., 1.) * omega[c];
           };
@@ -790,8 +760,8 @@ namespace PeriDEAL
                         MH(2 * j + s, c) = mode_rate(c) * MG(2 * j + s, c);
                       }
                 }
-              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov, weights);
-              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov, weights);
+              fg = fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
+              fh = fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
               if (increment)
                 {
                   // + e_i: cloud[0] = x_i, row 0 = level n.

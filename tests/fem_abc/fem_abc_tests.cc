@@ -475,10 +475,6 @@ namespace
             Fem::WaveBoundary::absorbing, "Wake angle exponent"),
           "Wake angle exponent with radii inside the cloud rejected naming Absorbing boundary/Wake angle exponent");
     // The weighted fit: W > 0, and k_W > 0 when W != 1.
-    check(rejected([](E13 &c) { c.abc.fit_weight = 0.; }, Fem::WaveBoundary::absorbing, "Fit weight"),
-          "Fit weight 0 rejected naming Absorbing boundary/Fit weight");
-    check(rejected([](E13 &c) { c.abc.fit_weight = 3.; }, Fem::WaveBoundary::absorbing, "Fit weight wave number"),
-          "Fit weight without its wave number rejected naming Absorbing boundary/Fit weight wave number");
   }
   /**
    * Backward Euler diffusion with the EBF ABC on (-1, 1)^2, h = 0.125, Q1

@@ -162,19 +162,6 @@ namespace PeriDEAL
        */
       double wake_angle_exponent = 0.;
       /**
-       * Weighted fit (1, the default: off, the unweighted fit bitwise
-       * unchanged). The updating vectors V = Psi M^+ are the least-squares
-       * fit over the modes (columns of M, ~190 for 5-6 cloud points); with
-       * a weight W != 1 they become V = (Psi D) (M D)^+ with the column
-       * weights D_c = 1 + (W - 1) exp(-(|k_c| / k_W)^2) (k_W:
-       * fit_weight_wave_number) of the harmonic modes (lattice modes 1):
-       * W > 1 makes the fit represent the slow (small |k|) modes, e.g. the
-       * 2D wake behind the front, more closely at the cost of the others.
-       */
-      double fit_weight = 1.;
-      /** k_W of the fit weight profile (> 0 when fit_weight != 1). */
-      double fit_weight_wave_number = 0.;
-      /**
        * "ebf" (the EBF extrapolation (4.82)) or "first order": the
        * conventional first-order ABC (4.75) u^{n+1} = u^n - dt (chi du/dn + d u^n),
        * with du/dn from a least-squares linear fit over x_i and the cone
