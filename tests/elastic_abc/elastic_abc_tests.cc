@@ -426,6 +426,102 @@ namespace
       }
   }
 
+  /** max over the samples of |Pi - Pi_ref| / Pi_ref(0). */
+  double
+  max_energy_error(const ElasticRunHistory &h, const ElasticRunHistory &ref)
+  {
+    double e = 0.;
+    for (unsigned int s = 0; s < h.times.size(); ++s)
+      e = std::max(e, energy_error(h, ref, s));
+    return e;
+  }
+
+  /** The conventional first-order (Lysmer-type) ABC of the elastic near field. */
+  WaveAbcParameters
+  first_order_parameters()
+  {
+    WaveAbcParameters prm = abc_parameters();
+    prm.method            = "first order";
+    return prm;
+  }
+
+  struct FirstOrderErrors
+  {
+    // max over the run of |Pi - Pi_ref|/Pi_ref(0), the field error at T.
+    double e_ebf, e_fo, e_free, e_pml, f_ebf, f_fo, f_free, f_pml, fo_growth, fo_verlet_growth;
+  };
+
+  /**
+   * E16 with the EBF layer, the first-order ABC, the free truncation and
+   * the PML (sigma_max 1, p 2, w = 6 from R - delta) against the free
+   * reference disc.
+   */
+  FirstOrderErrors
+  first_order_case(const Case &c)
+  {
+    Timer        timer;
+    const double cp     = std::sqrt(9. / 8.);
+    const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta) / c.dx) * c.dx;
+    const auto   ref    = run_case(c, radius, ElasticTruncation::free, abc_parameters());
+    const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, abc_parameters());
+    const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, first_order_parameters());
+    const auto   free   = run_case(c, c.R, ElasticTruncation::free, abc_parameters());
+    const auto   pml    = run_case(c, c.R - c.delta + 6., ElasticTruncation::absorbing, pml_parameters(1., 6., 2.));
+    FirstOrderErrors r;
+    r.e_ebf            = max_energy_error(ebf, ref);
+    r.e_fo             = max_energy_error(fo, ref);
+    r.e_free           = max_energy_error(free, ref);
+    r.e_pml            = max_energy_error(pml, ref);
+    r.f_ebf            = field_error(ebf, ref, c.w);
+    r.f_fo             = field_error(fo, ref, c.w);
+    r.f_free           = field_error(free, ref, c.w);
+    r.f_pml            = field_error(pml, ref, c.w);
+    r.fo_growth        = max_energy_increase(fo);
+    r.fo_verlet_growth = max_energy_increase(fo, true);
+    if (root())
+      {
+        std::cout << "    R = " << c.R << ", T = " << c.T << ", d = " << c.damping << ": first-order layer "
+                  << fo.n_layer_nodes << " nodes, fit points " << fo.stats.min_cloud_size << ".."
+                  << fo.stats.max_cloud_size << ", max |coefficient| " << sci(fo.stats.max_update_norm) << "\n";
+        for (unsigned int s = 0; s < ref.times.size(); ++s)
+          std::cout << "    t = " << ref.times[s] << ": |Pi-Pi_ref|/Pi0: EBF " << sci(energy_error(ebf, ref, s))
+                    << " first order " << sci(energy_error(fo, ref, s)) << " free " << sci(energy_error(free, ref, s))
+                    << " PML " << sci(energy_error(pml, ref, s)) << "  total FO/E0 " << sci(fo.total[s] / fo.total[0])
+                    << std::endl;
+        std::cout << "    max over the run |Pi - Pi_ref|/Pi0: EBF " << sci(r.e_ebf) << ", first order " << sci(r.e_fo)
+                  << ", free " << sci(r.e_free) << ", PML " << sci(r.e_pml) << "; first order / EBF "
+                  << r.e_fo / r.e_ebf << "\n    field error at T: EBF " << sci(r.f_ebf) << ", first order " << sci(r.f_fo)
+                  << ", free " << sci(r.f_free) << ", PML " << sci(r.f_pml) << "; first order / EBF " << r.f_fo / r.f_ebf
+                  << "\n    first order: max energy increase between samples " << sci(r.fo_growth) << " (Verlet "
+                  << sci(r.fo_verlet_growth) << "); " << timer.wall_time() << " s" << std::endl;
+      }
+    return r;
+  }
+
+  // The conventional first-order ABC as the baseline of the EBF layer
+  // (issue 4; doc/design.md, session 18) on E16 at CI size.
+  void
+  first_order()
+  {
+    Case c      = ci_case();
+    c.n_samples = 48;
+    const auto r = first_order_case(c);
+    (void)r;
+  }
+
+  void
+  first_order_scan()
+  {
+    const char *env = std::getenv("E16_FO_SCAN");
+    const std::string which = env ? env : "32";
+    Case c = which == "32" ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
+    if (which == "d0")
+      c.damping = 0.;
+    if (which != "32")
+      c.n_samples = 48;
+    first_order_case(c);
+  }
+
   // The coupled near-field/ABC recursion: spectral radius of the one-step
   // map of a small disc (R = 7) with and without the damping d = 0.02.
   void
@@ -869,5 +965,7 @@ main(int argc, char **argv)
               {"pml_long", pml_long},
               {"pml_spectral_radius", pml_spectral_radius},
               {"pml_scan", pml_scan},
-              {"pml_cost", pml_cost}});
+              {"pml_cost", pml_cost},
+              {"first_order", first_order},
+              {"first_order_scan", first_order_scan}});
 }
