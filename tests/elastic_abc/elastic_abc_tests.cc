@@ -267,6 +267,15 @@ namespace
     return prm;
   }
 
+  /** The conventional first-order (Lysmer-type) ABC of the elastic near field. */
+  WaveAbcParameters
+  first_order_parameters()
+  {
+    WaveAbcParameters prm = abc_parameters();
+    prm.method            = "first order";
+    return prm;
+  }
+
   /**
    * sum |u - u_ref|^2 / sum |u0|^2 over the compared region at the final
    * time (nodes matched by position: the lattices of both discs coincide).
@@ -399,17 +408,20 @@ namespace
   }
 
   // (d) The ABC run on all ranks equals the run on each rank alone; so
-  // does the PML run (its band rows and memories are owned).
+  // do the PML run (its band rows and memories are owned) and the
+  // first-order ABC run.
   void
   ranks()
   {
     Case c      = ci_case();
     c.T         = 24.;
     c.n_samples = 2;
-    for (const bool with_pml : {false, true})
+    for (const std::string method : {"ebf", "pml", "first order"})
       {
-        const std::string name   = with_pml ? "PML" : "EBF";
-        const auto        prm    = with_pml ? pml_parameters(1., 6., 2.) : abc_parameters();
+        const bool        with_pml = method == "pml";
+        const std::string name     = with_pml ? "PML" : method == "ebf" ? "EBF" : "first order";
+        const auto        prm      = with_pml ? pml_parameters(1., 6., 2.) : method == "ebf" ? abc_parameters() :
+                                                                                                 first_order_parameters();
         const double      radius = with_pml ? c.R + 3. : c.R;
         const auto        all    = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_WORLD);
         const auto        self   = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_SELF);
@@ -436,19 +448,12 @@ namespace
     return e;
   }
 
-  /** The conventional first-order (Lysmer-type) ABC of the elastic near field. */
-  WaveAbcParameters
-  first_order_parameters()
-  {
-    WaveAbcParameters prm = abc_parameters();
-    prm.method            = "first order";
-    return prm;
-  }
-
   struct FirstOrderErrors
   {
     // max over the run of |Pi - Pi_ref|/Pi_ref(0), the field error at T.
     double e_ebf, e_fo, e_free, e_pml, f_ebf, f_fo, f_free, f_pml, fo_growth, fo_verlet_growth;
+    // |Pi - Pi_ref|/Pi_ref(0) at T.
+    double e_ebf_T, e_fo_T, e_free_T, e_pml_T;
   };
 
   /**
@@ -478,6 +483,11 @@ namespace
     r.f_pml            = field_error(pml, ref, c.w);
     r.fo_growth        = max_energy_increase(fo);
     r.fo_verlet_growth = max_energy_increase(fo, true);
+    const unsigned int last = c.n_samples;
+    r.e_ebf_T          = energy_error(ebf, ref, last);
+    r.e_fo_T           = energy_error(fo, ref, last);
+    r.e_free_T         = energy_error(free, ref, last);
+    r.e_pml_T          = energy_error(pml, ref, last);
     if (root())
       {
         std::cout << "    R = " << c.R << ", T = " << c.T << ", d = " << c.damping << ": first-order layer "
@@ -492,6 +502,8 @@ namespace
                   << ", free " << sci(r.e_free) << ", PML " << sci(r.e_pml) << "; first order / EBF "
                   << r.e_fo / r.e_ebf << "\n    field error at T: EBF " << sci(r.f_ebf) << ", first order " << sci(r.f_fo)
                   << ", free " << sci(r.f_free) << ", PML " << sci(r.f_pml) << "; first order / EBF " << r.f_fo / r.f_ebf
+                  << "\n    at T |Pi - Pi_ref|/Pi0: EBF " << sci(r.e_ebf_T) << ", first order " << sci(r.e_fo_T) << ", free "
+                  << sci(r.e_free_T) << ", PML " << sci(r.e_pml_T) << "; first order / EBF " << r.e_fo_T / r.e_ebf_T
                   << "\n    first order: max energy increase between samples " << sci(r.fo_growth) << " (Verlet "
                   << sci(r.fo_verlet_growth) << "); " << timer.wall_time() << " s" << std::endl;
       }
@@ -503,10 +515,79 @@ namespace
   void
   first_order()
   {
+    // (a) R = 16, pulse width 2.5 (the CI case of elastic_abc.unbounded).
     Case c      = ci_case();
     c.n_samples = 48;
     const auto r = first_order_case(c);
-    (void)r;
+    // Measured (48 samples): max over the run EBF 2.59e-3, first order
+    // 2.60e-2, free 6.22e-2; at T: energy EBF 7.6e-4, first order 2.07e-2,
+    // free 3.78e-2; field EBF 2.74e-4, first order 5.81e-3, free 1.26e-2.
+    // Sanity: the first-order ABC absorbs (measured 0.42x / 0.55x / 0.46x
+    // of free; bound 0.7x).
+    check(r.e_fo < 0.7 * r.e_free && r.fo_growth <= 0.,
+          "R = 16, first order: max energy error " + sci(r.e_fo) + " < 0.7 x free " + sci(r.e_free) +
+            ", total energy non-increasing (" + sci(r.fo_growth) + ")");
+    check(r.f_fo < 0.7 * r.f_free,
+          "R = 16, first order: field error at T " + sci(r.f_fo) + " < 0.7 x free " + sci(r.f_free));
+    // The 10x at the end of the run (measured 27x energy, 21x
+    // field: a 2x margin).
+    const double e_fo_T = r.e_fo_T, e_ebf_T = r.e_ebf_T;
+    check(10. * e_ebf_T < e_fo_T,
+          "R = 16: EBF at least 10x closer than first order, energy at T: " + sci(e_ebf_T) + " vs " + sci(e_fo_T));
+    check(10. * r.f_ebf < r.f_fo,
+          "R = 16: EBF at least 10x closer than first order, field at T: " + sci(r.f_ebf) + " vs " + sci(r.f_fo));
+    // Over the whole run the ratio is only 10.0x (the EBF's worst sample,
+    // t = 19, is the first arrival at the layer): asserted 8x, not 10x.
+    check(8. * r.e_ebf < r.e_fo,
+          "R = 16: max energy error over the run EBF " + sci(r.e_ebf) + " at least 8x below first order " + sci(r.e_fo));
+
+    // (b) R = 32, pulse width 5 (the case of elastic_abc.unbounded_long to
+    // T = 96): long waves at normal incidence, where the Lysmer condition
+    // is nearly exact. Measured: max over the run EBF 5.26e-3, first order
+    // 4.81e-3 (first order better), free 1.32e-1; at T energy EBF 1.02e-4,
+    // first order 2.97e-4 (2.9x), field EBF 3.80e-5, first order 5.46e-5
+    // (1.44x). The 10x is NOT reached here (doc/design.md, session 18).
+    const auto r32 = first_order_case({32., 96., 5., 1., 3., 0.5, 48});
+    check(10. * r32.e_fo < r32.e_free && 10. * r32.f_fo < r32.f_free && r32.fo_growth <= 0.,
+          "R = 32, first order: at least 10x below free (energy " + sci(r32.e_fo) + " vs " + sci(r32.e_free) +
+            ", field " + sci(r32.f_fo) + " vs " + sci(r32.f_free) + "), energy non-increasing");
+    // Ordering at T as measured, bounds at about half the measured ratios
+    // (2.9x -> 1.5x, 1.44x -> 1.2x); over the run EBF within 1.5x of first
+    // order (measured 1.09x).
+    check(1.5 * r32.e_ebf_T < r32.e_fo_T && 1.2 * r32.f_ebf < r32.f_fo && r32.e_ebf < 1.5 * r32.e_fo,
+          "R = 32: EBF closer than first order at T (energy " + sci(r32.e_ebf_T) + " vs " + sci(r32.e_fo_T) +
+            ", field " + sci(r32.f_ebf) + " vs " + sci(r32.f_fo) + "), over the run within 1.5x (" +
+            sci(r32.e_ebf) + " vs " + sci(r32.e_fo) + ")");
+
+    // (c) Stability of the first-order layer: one-step radius of the R = 7
+    // disc (as spectral_radius for the EBF layer: 1 + 1.5e-2 at d = 0,
+    // 1 + 5.0e-3 at d = 0.02). Measured 1 + 3.0e-3 (46 eigenvalues outside)
+    // at d = 0, 1 - 7.0e-3 at d = 0.02.
+    LatticeParameters lp;
+    lp.dx    = 1.;
+    lp.delta = 3.;
+    FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+    std::map<double, double>       radius;
+    for (const double d : {0., 0.02})
+      {
+        ElasticWaveParameters wp;
+        wp.time_step = 0.5;
+        wp.damping   = d;
+        PdUnboundedElastic pd(MPI_COMM_SELF);
+        pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
+                 first_order_parameters(), u0);
+        unsigned int n_up = 0;
+        radius[d]         = pd.one_step_spectral_radius(4000, &n_up);
+        if (root())
+          std::cout << "    first order, R = 7, d = " << d << ": spectral radius - 1 = " << sci(radius[d] - 1.) << " ("
+                    << n_up << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
+      }
+    // 1e-12: round-off of the dense eigenproblem.
+    check(radius[0.02] <= 1. + 1e-12, "first order, d = 0.02: one-step radius <= 1 (1 + " + sci(radius[0.02] - 1.) + ")");
+    // Undamped it is unstable, as the EBF layer, but 5x more slowly
+    // (asserted: between 1 + 1e-3 and 1 + 1e-2).
+    check(radius[0.] > 1. + 1e-3 && radius[0.] < 1. + 1e-2,
+          "first order, d = 0: one-step radius 1 + " + sci(radius[0.] - 1.) + " in (1 + 1e-3, 1 + 1e-2)");
   }
 
   void
@@ -514,6 +595,28 @@ namespace
   {
     const char *env = std::getenv("E16_FO_SCAN");
     const std::string which = env ? env : "32";
+    if (which == "sr")
+      {
+        LatticeParameters lp;
+        lp.dx    = 1.;
+        lp.delta = 3.;
+        FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+        for (const double d : {0., 0.02})
+          {
+            ElasticWaveParameters wp;
+            wp.time_step = 0.5;
+            wp.damping   = d;
+            PdUnboundedElastic pd(MPI_COMM_SELF);
+            pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
+                     first_order_parameters(), u0);
+            unsigned int n_up = 0;
+            const double r    = pd.one_step_spectral_radius(4000, &n_up);
+            if (root())
+              std::cout << "    first order, R = 7, d = " << d << ": spectral radius - 1 = " << sci(r - 1.) << " (" << n_up
+                        << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
+          }
+        return;
+      }
     Case c = which == "32" ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
     if (which == "d0")
       c.damping = 0.;
