@@ -462,13 +462,13 @@ namespace
    * reference disc.
    */
   FirstOrderErrors
-  first_order_case(const Case &c)
+  first_order_case(const Case &c, const WaveAbcParameters &ebf_prm = abc_parameters())
   {
     Timer        timer;
     const double cp     = std::sqrt(9. / 8.);
     const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta) / c.dx) * c.dx;
     const auto   ref    = run_case(c, radius, ElasticTruncation::free, abc_parameters());
-    const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, abc_parameters());
+    const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, ebf_prm);
     const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, first_order_parameters());
     const auto   free   = run_case(c, c.R, ElasticTruncation::free, abc_parameters());
     const auto   pml    = run_case(c, c.R - c.delta + 6., ElasticTruncation::absorbing, pml_parameters(1., 6., 2.));
@@ -617,12 +617,39 @@ namespace
           }
         return;
       }
-    Case c = which == "32" ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
-    if (which == "d0")
+    // Keys (E16_FO_SCAN=32 or 16, then optional EBF overrides as
+    // "32 dk nk ndir dphi cone"): the EBF setting compared on E16.
+    std::istringstream in(which);
+    std::string        size;
+    in >> size;
+    Case c = size == "32" ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
+    if (size == "d0")
       c.damping = 0.;
-    if (which != "32")
-      c.n_samples = 48;
-    first_order_case(c);
+    c.n_samples           = 48;
+    WaveAbcParameters prm = abc_parameters();
+    double            dk, dphi, cone;
+    unsigned int      nk, ndir;
+    if (in >> dk >> nk >> ndir >> dphi >> cone)
+      {
+        prm.wave_number_range = dk;
+        prm.n_wave_numbers    = nk;
+        prm.n_directions      = ndir;
+        prm.direction_range   = dphi;
+        prm.cone_angle        = cone;
+      }
+    try
+      {
+        const auto r = first_order_case(c, prm);
+        if (root())
+          std::cout << "SCAN " << which << ": EBF max " << sci(r.e_ebf) << " T " << sci(r.e_ebf_T) << " field "
+                    << sci(r.f_ebf) << " | FO/EBF max " << r.e_fo / r.e_ebf << " T " << r.e_fo_T / r.e_ebf_T << " field "
+                    << r.f_fo / r.f_ebf << std::endl;
+      }
+    catch (const std::exception &e)
+      {
+        if (root())
+          std::cout << "SCAN " << which << ": " << e.what() << std::endl;
+      }
   }
 
   // The coupled near-field/ABC recursion: spectral radius of the one-step
