@@ -197,6 +197,8 @@ namespace
     unsigned int n_samples;
     /** d of the run (the E16 runs: 2% of omega_P(k = 1), see run_case()). */
     double damping = 0.02;
+    /** Pulse centre (offset, 0): oblique incidence (first_order_scan only). */
+    double offset = 0.;
   };
 
   Case
@@ -238,9 +240,10 @@ namespace
     // scalar-wave instability; doc/design.md). The reference is damped alike.
     wp.damping = c.damping;
     const double                   w = c.w;
+    const Point<2>                 o(c.offset, 0.);
     FunctionFromFunctionObjects<2> u0(
-      {[w](const Point<2> &x) { return x[0] / w * std::exp(-x.square() / (w * w)); },
-       [w](const Point<2> &x) { return x[1] / w * std::exp(-x.square() / (w * w)); }});
+      {[w, o](const Point<2> &x) { return (x[0] - o[0]) / w * std::exp(-(x - o).norm_square() / (w * w)); },
+       [w, o](const Point<2> &x) { return (x[1] - o[1]) / w * std::exp(-(x - o).norm_square() / (w * w)); }});
     pd.setup(BallDomain<2>(Point<2>(), radius), lp, linear_model(), wp, tr, prm, u0);
   }
 
@@ -466,7 +469,7 @@ namespace
   {
     Timer        timer;
     const double cp     = std::sqrt(9. / 8.);
-    const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w, c.R, 2. * c.delta) / c.dx) * c.dx;
+    const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w + c.offset, c.R, 2. * c.delta) / c.dx) * c.dx;
     const auto   ref    = run_case(c, radius, ElasticTruncation::free, abc_parameters());
     const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, ebf_prm);
     const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, first_order_parameters());
@@ -622,9 +625,12 @@ namespace
     std::istringstream in(which);
     std::string        size;
     in >> size;
-    Case c = size == "32" ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
+    Case c = size[0] == '3' ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
     if (size == "d0")
       c.damping = 0.;
+    // "16o", "32o": the pulse at (R/2, 0).
+    if (size.back() == 'o')
+      c.offset = c.R / 2.;
     c.n_samples           = 48;
     WaveAbcParameters prm = abc_parameters();
     double            dk, dphi, cone;
