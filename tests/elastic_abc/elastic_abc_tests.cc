@@ -593,45 +593,19 @@ namespace
           "first order, d = 0: one-step radius 1 + " + sci(radius[0.] - 1.) + " in (1 + 1e-3, 1 + 1e-2)");
   }
 
+  // Exploration (not in CI): E16_FO_SCAN="<mode> [dk nk ndir dphi cone [vmax]]",
+  // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)):
+  // the comparison of first_order_case() with the EBF setting of the optional
+  // keys; sr: one-step radius of the R = 7 disc (first order and that EBF,
+  // d = 0 and 0.02); long16 / long32: that EBF run alone to t = 5000.
   void
   first_order_scan()
   {
-    const char *env = std::getenv("E16_FO_SCAN");
+    const char       *env   = std::getenv("E16_FO_SCAN");
     const std::string which = env ? env : "32";
-    if (which == "sr")
-      {
-        LatticeParameters lp;
-        lp.dx    = 1.;
-        lp.delta = 3.;
-        FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
-        for (const double d : {0., 0.02})
-          {
-            ElasticWaveParameters wp;
-            wp.time_step = 0.5;
-            wp.damping   = d;
-            PdUnboundedElastic pd(MPI_COMM_SELF);
-            pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
-                     first_order_parameters(), u0);
-            unsigned int n_up = 0;
-            const double r    = pd.one_step_spectral_radius(4000, &n_up);
-            if (root())
-              std::cout << "    first order, R = 7, d = " << d << ": spectral radius - 1 = " << sci(r - 1.) << " (" << n_up
-                        << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
-          }
-        return;
-      }
-    // Keys (E16_FO_SCAN=32 or 16, then optional EBF overrides as
-    // "32 dk nk ndir dphi cone"): the EBF setting compared on E16.
     std::istringstream in(which);
     std::string        size;
     in >> size;
-    Case c = size[0] == '3' ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
-    if (size == "d0")
-      c.damping = 0.;
-    // "16o", "32o": the pulse at (R/2, 0).
-    if (size.back() == 'o')
-      c.offset = c.R / 2.;
-    c.n_samples           = 48;
     WaveAbcParameters prm = abc_parameters();
     double            dk, dphi, cone;
     unsigned int      nk, ndir;
@@ -642,9 +616,60 @@ namespace
         prm.n_directions      = ndir;
         prm.direction_range   = dphi;
         prm.cone_angle        = cone;
+        double vmax;
+        if (in >> vmax)
+          prm.max_update_norm = vmax;
       }
     try
       {
+        if (size == "sr")
+          {
+            LatticeParameters lp;
+            lp.dx    = 1.;
+            lp.delta = 3.;
+            FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+            for (const bool fo : {true, false})
+              for (const double d : {0., 0.02})
+                {
+                  ElasticWaveParameters wp;
+                  wp.time_step = 0.5;
+                  wp.damping   = d;
+                  PdUnboundedElastic pd(MPI_COMM_SELF);
+                  pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
+                           fo ? first_order_parameters() : prm, u0);
+                  unsigned int n_up = 0;
+                  const double r    = pd.one_step_spectral_radius(4000, &n_up);
+                  if (root())
+                    std::cout << "SCAN " << which << ": " << (fo ? "first order" : "EBF") << ", R = 7, d = " << d
+                              << ": spectral radius - 1 = " << sci(r - 1.) << " (" << n_up
+                              << " eigenvalues of modulus > 1 + 1e-8), max|V| "
+                              << sci(pd.absorbing_boundary().statistics().max_update_norm) << std::endl;
+                }
+            return;
+          }
+        Case c = size.find("32") != std::string::npos ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
+        if (size == "d0")
+          c.damping = 0.;
+        c.n_samples = 48;
+        if (size.rfind("long", 0) == 0)
+          {
+            c.T         = 5000.;
+            c.n_samples = 50;
+            const auto h = run_case(c, c.R, ElasticTruncation::absorbing, prm);
+            if (root())
+              {
+                for (unsigned int s = 0; s < h.times.size(); s += 5)
+                  std::cout << "    t = " << h.times[s] << ": total/E0 " << sci(h.total[s] / h.total[0]) << std::endl;
+                std::cout << "SCAN " << which << ": max|V| " << sci(h.stats.max_update_norm) << ", cond "
+                          << sci(h.stats.max_condition_number) << ", thinned " << h.stats.n_thinned << ", E(5000)/E0 "
+                          << sci(h.total.back() / h.total[0]) << ", max increase between samples "
+                          << sci(max_energy_increase(h)) << std::endl;
+              }
+            return;
+          }
+        // "16o", "32o": the pulse at (R/2, 0).
+        if (size.back() == 'o')
+          c.offset = c.R / 2.;
         const auto r = first_order_case(c, prm);
         if (root())
           std::cout << "SCAN " << which << ": EBF max " << sci(r.e_ebf) << " T " << sci(r.e_ebf_T) << " field "
