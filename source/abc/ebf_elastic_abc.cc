@@ -187,6 +187,8 @@ namespace PeriDEAL
       unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
       unsigned int n_thinned = 0, max_stride = 1;
       const bool   first_order = prm.method == "first order";
+      if (first_order)
+        stats.n_modes = 0;
       // The undamped relation for the long-wave speeds of the first-order ABC.
       ElasticDispersion undamped = dispersion;
       undamped.damping           = 0.;
