@@ -465,14 +465,15 @@ namespace
    * reference disc.
    */
   FirstOrderErrors
-  first_order_case(const Case &c, const WaveAbcParameters &ebf_prm = abc_parameters())
+  first_order_case(const Case &c, const WaveAbcParameters &ebf_prm = abc_parameters(),
+                   const WaveAbcParameters &fo_prm = first_order_parameters())
   {
     Timer        timer;
     const double cp     = std::sqrt(9. / 8.);
     const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w + c.offset, c.R, 2. * c.delta) / c.dx) * c.dx;
     const auto   ref    = run_case(c, radius, ElasticTruncation::free, abc_parameters());
     const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, ebf_prm);
-    const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, first_order_parameters());
+    const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, fo_prm);
     const auto   free   = run_case(c, c.R, ElasticTruncation::free, abc_parameters());
     const auto   pml    = run_case(c, c.R - c.delta + 6., ElasticTruncation::absorbing, pml_parameters(1., 6., 2.));
     FirstOrderErrors r;
@@ -611,7 +612,8 @@ namespace
   }
 
   // Exploration (not in CI): E16_FO_SCAN="<mode> [dk nk ndir dphi cone [vmax [tol]]]",
-  // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)):
+  // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
+  // 16l / 32l (first order with the continuum speeds):
   // the comparison of first_order_case() with the EBF setting of the optional
   // keys; sr: one-step radius of the R = 7 disc (first order and that EBF,
   // d = 0 and 0.02); long16 / long32: that EBF run alone to t = 5000.
@@ -648,6 +650,15 @@ namespace
             lp.dx    = 1.;
             lp.delta = 3.;
             FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+            // The long-wave speeds the first-order ABC uses (discrete relation).
+            const auto rel = ElasticDispersion::discrete(linear_model(), lp, 1., 0.);
+            for (const double phi : {0., M_PI / 8., M_PI / 4.})
+              {
+                const auto md = rel.modes(1e-4, unit(phi));
+                if (root())
+                  std::cout << "SCAN sr: phi " << phi << ": c_P^2 " << std::norm(md[0].frequency) / 1e-8 << ", c_S^2 "
+                            << std::norm(md[1].frequency) / 1e-8 << " (continuum 9/8, 3/8)" << std::endl;
+              }
             for (const bool fo : {true, false})
               for (const double d : {0., 0.02})
                 {
@@ -690,7 +701,11 @@ namespace
         // "16o", "32o": the pulse at (R/2, 0).
         if (size.back() == 'o')
           c.offset = c.R / 2.;
-        const auto r = first_order_case(c, prm);
+        // "16l", "32l": the first-order ABC with the continuum (local) speeds.
+        WaveAbcParameters fo_prm = first_order_parameters();
+        if (size.back() == 'l')
+          fo_prm.dispersion = "local";
+        const auto r = first_order_case(c, prm, fo_prm);
         if (root())
           std::cout << "SCAN " << which << ": EBF max " << sci(r.e_ebf) << " T " << sci(r.e_ebf_T) << " field "
                     << sci(r.f_ebf) << " | FO/EBF max " << r.e_fo / r.e_ebf << " T " << r.e_fo_T / r.e_ebf_T << " field "
