@@ -186,10 +186,86 @@ namespace PeriDEAL
       double       max_cond = 0., max_norm = 0.;
       unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
       unsigned int n_thinned = 0, max_stride = 1;
+      const bool   first_order = prm.method == "first order";
+      if (first_order)
+        stats.n_modes = 0;
+      // The undamped relation for the long-wave speeds of the first-order ABC.
+      ElasticDispersion undamped = dispersion;
+      undamped.damping           = 0.;
       for (unsigned int a = 0; a < absorbing.size(); ++a)
         {
           const unsigned int  i = absorbing[a];
           const Tensor<2, 2>  R = EbfWaveAbc<2>::local_frame(normals[a]);
+          if (first_order)
+            {
+              // Lysmer-type one-way condition by forward Euler (the vector
+              // analogue of the scalar first-order ABC of EbfWaveAbc):
+              // u^{n+1} = (1 - d dt) u^n - dt C du/dn, C = c_P n n^T + c_S
+              // (I - n n^T) with the long-wave (k -> 0) P and S speeds of
+              // the relation along n (the local Navier limit for "local"),
+              // du/dn from a linear least-squares fit over x_i and the cone
+              // points within min(d_inf, 2 dx) (upwind); v alike.
+              const Tensor<1, 2> n = normals[a] / normals[a].norm();
+              const double       eps = 1e-4;
+              const auto         md  = undamped.modes(eps, n);
+              // C from the two modes (their polarizations are orthonormal):
+              // for the discrete relation they deviate from n, n_perp by
+              // the lattice anisotropy only.
+              Tensor<2, 2> C;
+              for (unsigned int b = 0; b < 2; ++b)
+                C += (std::abs(md[b].frequency) / eps) * outer_product(md[b].polarization, md[b].polarization);
+              const auto                             cone = builder.cone(i, R);
+              std::vector<EbfCloudBuilder<2>::Entry> sel;
+              Eigen::MatrixXd                        A;
+              Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+              // Within min(d_inf, 2 dx) first; when these are collinear (a
+              // lattice-aligned normal with a cone of half-angle >= pi/4 holds
+              // only (-dx, 0), (-2 dx, 0) there) the whole cone (d_inf).
+              for (const double radius : {std::min(prm.cloud_radius, 2. * dx), prm.cloud_radius})
+                {
+                  sel.assign(1, cone[0]);
+                  for (unsigned int c = 1; c < cone.size(); ++c)
+                    if (cone[c].second.norm() <= radius * (1. + 1e-10))
+                      sel.push_back(cone[c]);
+                  A.resize(sel.size(), 3);
+                  for (unsigned int q = 0; q < sel.size(); ++q)
+                    {
+                      A(q, 0) = 1.;
+                      A(q, 1) = sel[q].second[0];
+                      A(q, 2) = sel[q].second[1];
+                    }
+                  cod.compute(A);
+                  if (cod.rank() == 3)
+                    break;
+                }
+              check_parameter(cod.rank() == 3, "Absorbing boundary/Cloud radius", prm.cloud_radius,
+                              "a radius whose cone behind absorbing node " + std::to_string(ids[i]) +
+                                " holds enough points for a linear fit (first-order ABC)");
+              const Eigen::MatrixXd P = cod.pseudoInverse();
+              for (unsigned int q = 0; q < sel.size(); ++q)
+                {
+                  // Row 1 of P: d/dx bar = d/dn (x bar along the outward normal).
+                  cloud_index.push_back(sel[q].first);
+                  for (unsigned int p = 0; p < 2; ++p)
+                    for (unsigned int r = 0; r < 2; ++r)
+                      {
+                        const double c = -dt * C[p][r] * P(1, q) +
+                                         (q == 0 && p == r ? 1. - dt * dispersion.damping : 0.);
+                        // Entry layout [p][q][level] (q = r): level n only;
+                        // the same coefficients for u and v.
+                        for (auto *w : {&vg, &vh})
+                          {
+                            w->push_back(c);
+                            w->push_back(0.);
+                          }
+                        max_norm = std::max(max_norm, std::abs(c));
+                      }
+                }
+              cloud_start.push_back(cloud_index.size());
+              min_size = std::min<unsigned int>(min_size, sel.size());
+              max_size = std::max<unsigned int>(max_size, sel.size());
+              continue;
+            }
           // Per column: local wave vector, rate -d - i omega~, polarization (global).
           std::vector<Tensor<1, 2>>         kv(n_cols), gamma(n_cols);
           std::vector<std::complex<double>> rate(n_cols);
@@ -361,8 +437,10 @@ namespace PeriDEAL
       t  = 0.;
       // ElasticTruncation::absorbing follows the method parameter.
       check_parameter(trunc != ElasticTruncation::absorbing || prm_in.method == "ebf" ||
-                        prm_in.method == "sponge" || prm_in.method == "pml",
-                      "Absorbing boundary/Method", prm_in.method, "ebf, sponge or pml (elastic waves)");
+                        prm_in.method == "first order" || prm_in.method == "sponge" ||
+                        prm_in.method == "pml",
+                      "Absorbing boundary/Method", prm_in.method,
+                      "ebf, first order, sponge or pml (elastic waves)");
       truncation = trunc != ElasticTruncation::absorbing ? trunc :
                    prm_in.method == "sponge"            ? ElasticTruncation::sponge :
                    prm_in.method == "pml"               ? ElasticTruncation::pml :

@@ -197,6 +197,8 @@ namespace
     unsigned int n_samples;
     /** d of the run (the E16 runs: 2% of omega_P(k = 1), see run_case()). */
     double damping = 0.02;
+    /** Pulse centre (offset, 0): oblique incidence (first_order_scan only). */
+    double offset = 0.;
   };
 
   Case
@@ -238,9 +240,10 @@ namespace
     // scalar-wave instability; doc/design.md). The reference is damped alike.
     wp.damping = c.damping;
     const double                   w = c.w;
+    const Point<2>                 o(c.offset, 0.);
     FunctionFromFunctionObjects<2> u0(
-      {[w](const Point<2> &x) { return x[0] / w * std::exp(-x.square() / (w * w)); },
-       [w](const Point<2> &x) { return x[1] / w * std::exp(-x.square() / (w * w)); }});
+      {[w, o](const Point<2> &x) { return (x[0] - o[0]) / w * std::exp(-(x - o).norm_square() / (w * w)); },
+       [w, o](const Point<2> &x) { return (x[1] - o[1]) / w * std::exp(-(x - o).norm_square() / (w * w)); }});
     pd.setup(BallDomain<2>(Point<2>(), radius), lp, linear_model(), wp, tr, prm, u0);
   }
 
@@ -264,6 +267,15 @@ namespace
     prm.pml_damping       = sigma_max;
     prm.pml_thickness     = w;
     prm.pml_exponent      = p;
+    return prm;
+  }
+
+  /** The conventional first-order (Lysmer-type) ABC of the elastic near field. */
+  WaveAbcParameters
+  first_order_parameters()
+  {
+    WaveAbcParameters prm = abc_parameters();
+    prm.method            = "first order";
     return prm;
   }
 
@@ -399,17 +411,20 @@ namespace
   }
 
   // (d) The ABC run on all ranks equals the run on each rank alone; so
-  // does the PML run (its band rows and memories are owned).
+  // do the PML run (its band rows and memories are owned) and the
+  // first-order ABC run.
   void
   ranks()
   {
     Case c      = ci_case();
     c.T         = 24.;
     c.n_samples = 2;
-    for (const bool with_pml : {false, true})
+    for (const std::string method : {"ebf", "pml", "first order"})
       {
-        const std::string name   = with_pml ? "PML" : "EBF";
-        const auto        prm    = with_pml ? pml_parameters(1., 6., 2.) : abc_parameters();
+        const bool        with_pml = method == "pml";
+        const std::string name     = with_pml ? "PML" : method == "ebf" ? "EBF" : "first order";
+        const auto        prm      = with_pml ? pml_parameters(1., 6., 2.) : method == "ebf" ? abc_parameters() :
+                                                                                                 first_order_parameters();
         const double      radius = with_pml ? c.R + 3. : c.R;
         const auto        all    = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_WORLD);
         const auto        self   = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_SELF);
@@ -423,6 +438,283 @@ namespace
         check(diff <= 1e-12 * norm, name + ": u on " + std::to_string(Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD)) +
                                        " ranks equals u on 1 rank: max |diff| / max |u| = " + sci(diff / norm));
         check_close(all.energy(2), self.energy(2), 1e-12, name + ": energy at T on all ranks vs 1 rank");
+      }
+  }
+
+  /** max over the samples of |Pi - Pi_ref| / Pi_ref(0). */
+  double
+  max_energy_error(const ElasticRunHistory &h, const ElasticRunHistory &ref)
+  {
+    double e = 0.;
+    for (unsigned int s = 0; s < h.times.size(); ++s)
+      e = std::max(e, energy_error(h, ref, s));
+    return e;
+  }
+
+  struct FirstOrderErrors
+  {
+    // max over the run of |Pi - Pi_ref|/Pi_ref(0), the field error at T.
+    double e_ebf, e_fo, e_free, e_pml, f_ebf, f_fo, f_free, f_pml, fo_growth, fo_verlet_growth;
+    // |Pi - Pi_ref|/Pi_ref(0) at T.
+    double e_ebf_T, e_fo_T, e_free_T, e_pml_T;
+  };
+
+  /**
+   * E16 with the EBF layer, the first-order ABC, the free truncation and
+   * the PML (sigma_max 1, p 2, w = 6 from R - delta) against the free
+   * reference disc.
+   */
+  FirstOrderErrors
+  first_order_case(const Case &c, const WaveAbcParameters &ebf_prm = abc_parameters(),
+                   const WaveAbcParameters &fo_prm = first_order_parameters())
+  {
+    Timer        timer;
+    const double cp     = std::sqrt(9. / 8.);
+    const double radius = std::ceil(reference_radius(cp * 1.02, c.T, 3. * c.w + c.offset, c.R, 2. * c.delta) / c.dx) * c.dx;
+    const auto   ref    = run_case(c, radius, ElasticTruncation::free, abc_parameters());
+    const auto   ebf    = run_case(c, c.R, ElasticTruncation::absorbing, ebf_prm);
+    const auto   fo     = run_case(c, c.R, ElasticTruncation::absorbing, fo_prm);
+    const auto   free   = run_case(c, c.R, ElasticTruncation::free, abc_parameters());
+    const auto   pml    = run_case(c, c.R - c.delta + 6., ElasticTruncation::absorbing, pml_parameters(1., 6., 2.));
+    FirstOrderErrors r;
+    r.e_ebf            = max_energy_error(ebf, ref);
+    r.e_fo             = max_energy_error(fo, ref);
+    r.e_free           = max_energy_error(free, ref);
+    r.e_pml            = max_energy_error(pml, ref);
+    r.f_ebf            = field_error(ebf, ref, c.w);
+    r.f_fo             = field_error(fo, ref, c.w);
+    r.f_free           = field_error(free, ref, c.w);
+    r.f_pml            = field_error(pml, ref, c.w);
+    r.fo_growth        = max_energy_increase(fo);
+    r.fo_verlet_growth = max_energy_increase(fo, true);
+    const unsigned int last = c.n_samples;
+    r.e_ebf_T          = energy_error(ebf, ref, last);
+    r.e_fo_T           = energy_error(fo, ref, last);
+    r.e_free_T         = energy_error(free, ref, last);
+    r.e_pml_T          = energy_error(pml, ref, last);
+    if (root())
+      {
+        std::cout << "    R = " << c.R << ", T = " << c.T << ", d = " << c.damping << ": first-order layer "
+                  << fo.n_layer_nodes << " nodes, fit points " << fo.stats.min_cloud_size << ".."
+                  << fo.stats.max_cloud_size << ", max |coefficient| " << sci(fo.stats.max_update_norm) << "\n";
+        for (unsigned int s = 0; s < ref.times.size(); ++s)
+          std::cout << "    t = " << ref.times[s] << ": |Pi-Pi_ref|/Pi0: EBF " << sci(energy_error(ebf, ref, s))
+                    << " first order " << sci(energy_error(fo, ref, s)) << " free " << sci(energy_error(free, ref, s))
+                    << " PML " << sci(energy_error(pml, ref, s)) << "  total FO/E0 " << sci(fo.total[s] / fo.total[0])
+                    << std::endl;
+        std::cout << "    max over the run |Pi - Pi_ref|/Pi0: EBF " << sci(r.e_ebf) << ", first order " << sci(r.e_fo)
+                  << ", free " << sci(r.e_free) << ", PML " << sci(r.e_pml) << "; first order / EBF "
+                  << r.e_fo / r.e_ebf << "\n    field error at T: EBF " << sci(r.f_ebf) << ", first order " << sci(r.f_fo)
+                  << ", free " << sci(r.f_free) << ", PML " << sci(r.f_pml) << "; first order / EBF " << r.f_fo / r.f_ebf
+                  << "\n    at T |Pi - Pi_ref|/Pi0: EBF " << sci(r.e_ebf_T) << ", first order " << sci(r.e_fo_T) << ", free "
+                  << sci(r.e_free_T) << ", PML " << sci(r.e_pml_T) << "; first order / EBF " << r.e_fo_T / r.e_ebf_T
+                  << "\n    first order: max energy increase between samples " << sci(r.fo_growth) << " (Verlet "
+                  << sci(r.fo_verlet_growth) << "); " << timer.wall_time() << " s" << std::endl;
+      }
+    return r;
+  }
+
+  // The conventional first-order ABC as the baseline of the EBF layer
+  // (issue 4; doc/design.md, session 18) on E16 at CI size.
+  void
+  first_order()
+  {
+    // (a) R = 16, pulse width 2.5 (the CI case of elastic_abc.unbounded).
+    Case c      = ci_case();
+    c.n_samples = 48;
+    const auto r = first_order_case(c);
+    // Measured (48 samples): max over the run EBF 2.59e-3, first order
+    // 2.60e-2, free 6.22e-2; at T: energy EBF 7.6e-4, first order 2.07e-2,
+    // free 3.78e-2; field EBF 2.74e-4, first order 5.81e-3, free 1.26e-2.
+    // Sanity: the first-order ABC absorbs (measured 0.42x / 0.55x / 0.46x
+    // of free; bound 0.7x).
+    check(r.e_fo < 0.7 * r.e_free && r.fo_growth <= 0.,
+          "R = 16, first order: max energy error " + sci(r.e_fo) + " < 0.7 x free " + sci(r.e_free) +
+            ", total energy non-increasing (" + sci(r.fo_growth) + ")");
+    check(r.f_fo < 0.7 * r.f_free,
+          "R = 16, first order: field error at T " + sci(r.f_fo) + " < 0.7 x free " + sci(r.f_free));
+    // The issue's 10x at the end of the run (measured 27x energy, 21x
+    // field: a 2x margin).
+    const double e_fo_T = r.e_fo_T, e_ebf_T = r.e_ebf_T;
+    check(10. * e_ebf_T < e_fo_T,
+          "R = 16: EBF at least 10x closer than first order, energy at T: " + sci(e_ebf_T) + " vs " + sci(e_fo_T));
+    check(10. * r.f_ebf < r.f_fo,
+          "R = 16: EBF at least 10x closer than first order, field at T: " + sci(r.f_ebf) + " vs " + sci(r.f_fo));
+    // Over the whole run the ratio is only 10.0x (the EBF's worst sample,
+    // t = 19, is the first arrival at the layer): asserted 8x, not 10x.
+    check(8. * r.e_ebf < r.e_fo,
+          "R = 16: max energy error over the run EBF " + sci(r.e_ebf) + " at least 8x below first order " + sci(r.e_fo));
+
+    // (b) R = 32, pulse width 5 (the case of elastic_abc.unbounded_long to
+    // T = 96): long waves at normal incidence, where the Lysmer condition
+    // is nearly exact. Measured: max over the run EBF 5.26e-3, first order
+    // 4.81e-3 (first order better), free 1.32e-1; at T energy EBF 1.02e-4,
+    // first order 2.97e-4 (2.9x), field EBF 3.80e-5, first order 5.46e-5
+    // (1.44x). With the default EBF setting the issue's 10x is NOT reached
+    // here (doc/design.md, session 18; see (b') for a matched setting).
+    const auto r32 = first_order_case({32., 96., 5., 1., 3., 0.5, 48});
+    check(10. * r32.e_fo < r32.e_free && 10. * r32.f_fo < r32.f_free && r32.fo_growth <= 0.,
+          "R = 32, first order: at least 10x below free (energy " + sci(r32.e_fo) + " vs " + sci(r32.e_free) +
+            ", field " + sci(r32.f_fo) + " vs " + sci(r32.f_free) + "), energy non-increasing");
+    // Ordering at T as measured, bounds at about half the measured ratios
+    // (2.9x -> 1.5x, 1.44x -> 1.2x); over the run EBF within 1.5x of first
+    // order (measured 1.09x).
+    check(1.5 * r32.e_ebf_T < r32.e_fo_T && 1.2 * r32.f_ebf < r32.f_fo && r32.e_ebf < 1.5 * r32.e_fo,
+          "R = 32: EBF closer than first order at T (energy " + sci(r32.e_ebf_T) + " vs " + sci(r32.e_fo_T) +
+            ", field " + sci(r32.f_ebf) + " vs " + sci(r32.f_fo) + "), over the run within 1.5x (" +
+            sci(r32.e_ebf) + " vs " + sci(r32.e_fo) + ")");
+
+    // (b') The same R = 32 case with the EBF modes matched to the longer
+    // pulse (Delta k 0.5 instead of 1, Delta k w = 2.5 as for R = 16) and a
+    // truncated pseudo-inverse (singular values below 3e-2 sigma_max
+    // dropped; max|V| 0.29, cond 33): measured at T energy 8.46e-6 (35x
+    // below first order), field 1.93e-6 (28x), over the run 5.62e-4
+    // (8.6x). Asserted: 10x at T (a 2.8x margin), 5x over the run. Not
+    // the default: on R = 16 this setting is only 6.5x (doc/design.md).
+    WaveAbcParameters matched        = abc_parameters();
+    matched.wave_number_range        = 0.5;
+    matched.pseudo_inverse_tolerance = 3e-2;
+    const auto m32 = first_order_case({32., 96., 5., 1., 3., 0.5, 48}, matched);
+    check(10. * m32.e_ebf_T < m32.e_fo_T && 10. * m32.f_ebf < m32.f_fo && 5. * m32.e_ebf < m32.e_fo,
+          "R = 32, EBF Delta k 0.5, truncation 3e-2: at least 10x closer than first order at T (energy " +
+            sci(m32.e_ebf_T) + " vs " + sci(m32.e_fo_T) + ", field " + sci(m32.f_ebf) + " vs " + sci(m32.f_fo) +
+            "), 5x over the run (" + sci(m32.e_ebf) + " vs " + sci(m32.e_fo) + ")");
+
+    // (c) Stability of the first-order layer: one-step radius of the R = 7
+    // disc (as spectral_radius for the EBF layer: 1 + 1.5e-2 at d = 0,
+    // 1 + 5.0e-3 at d = 0.02). Measured 1 + 3.0e-3 (46 eigenvalues outside)
+    // at d = 0, 1 - 7.0e-3 at d = 0.02.
+    LatticeParameters lp;
+    lp.dx    = 1.;
+    lp.delta = 3.;
+    FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+    std::map<double, double>       radius;
+    for (const double d : {0., 0.02})
+      {
+        ElasticWaveParameters wp;
+        wp.time_step = 0.5;
+        wp.damping   = d;
+        PdUnboundedElastic pd(MPI_COMM_SELF);
+        pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
+                 first_order_parameters(), u0);
+        unsigned int n_up = 0;
+        radius[d]         = pd.one_step_spectral_radius(4000, &n_up);
+        if (root())
+          std::cout << "    first order, R = 7, d = " << d << ": spectral radius - 1 = " << sci(radius[d] - 1.) << " ("
+                    << n_up << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
+      }
+    // 1e-12: round-off of the dense eigenproblem.
+    check(radius[0.02] <= 1. + 1e-12, "first order, d = 0.02: one-step radius <= 1 (1 + " + sci(radius[0.02] - 1.) + ")");
+    // Undamped it is unstable, as the EBF layer, but 5x more slowly
+    // (asserted: between 1 + 1e-3 and 1 + 1e-2).
+    check(radius[0.] > 1. + 1e-3 && radius[0.] < 1. + 1e-2,
+          "first order, d = 0: one-step radius 1 + " + sci(radius[0.] - 1.) + " in (1 + 1e-3, 1 + 1e-2)");
+  }
+
+  // Exploration (not in CI): E16_FO_SCAN="<mode> [dk nk ndir dphi cone [vmax [tol]]]",
+  // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
+  // 16l / 32l (first order with the continuum speeds):
+  // the comparison of first_order_case() with the EBF setting of the optional
+  // keys; sr: one-step radius of the R = 7 disc (first order and that EBF,
+  // d = 0 and 0.02); long16 / long32: that EBF run alone to t = 5000.
+  void
+  first_order_scan()
+  {
+    const char       *env   = std::getenv("E16_FO_SCAN");
+    const std::string which = env ? env : "32";
+    std::istringstream in(which);
+    std::string        size;
+    in >> size;
+    WaveAbcParameters prm = abc_parameters();
+    double            dk, dphi, cone;
+    unsigned int      nk, ndir;
+    if (in >> dk >> nk >> ndir >> dphi >> cone)
+      {
+        prm.wave_number_range = dk;
+        prm.n_wave_numbers    = nk;
+        prm.n_directions      = ndir;
+        prm.direction_range   = dphi;
+        prm.cone_angle        = cone;
+        double vmax;
+        double tol;
+        if (in >> vmax)
+          prm.max_update_norm = vmax;
+        if (in >> tol)
+          prm.pseudo_inverse_tolerance = tol;
+      }
+    try
+      {
+        if (size == "sr")
+          {
+            LatticeParameters lp;
+            lp.dx    = 1.;
+            lp.delta = 3.;
+            FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+            // The long-wave speeds the first-order ABC uses (discrete relation).
+            const auto rel = ElasticDispersion::discrete(linear_model(), lp, 1., 0.);
+            for (const double phi : {0., M_PI / 8., M_PI / 4.})
+              {
+                const auto md = rel.modes(1e-4, unit(phi));
+                if (root())
+                  std::cout << "SCAN sr: phi " << phi << ": c_P^2 " << std::norm(md[0].frequency) / 1e-8 << ", c_S^2 "
+                            << std::norm(md[1].frequency) / 1e-8 << " (continuum 9/8, 3/8)" << std::endl;
+              }
+            for (const bool fo : {true, false})
+              for (const double d : {0., 0.02})
+                {
+                  ElasticWaveParameters wp;
+                  wp.time_step = 0.5;
+                  wp.damping   = d;
+                  PdUnboundedElastic pd(MPI_COMM_SELF);
+                  pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
+                           fo ? first_order_parameters() : prm, u0);
+                  unsigned int n_up = 0;
+                  const double r    = pd.one_step_spectral_radius(4000, &n_up);
+                  if (root())
+                    std::cout << "SCAN " << which << ": " << (fo ? "first order" : "EBF") << ", R = 7, d = " << d
+                              << ": spectral radius - 1 = " << sci(r - 1.) << " (" << n_up
+                              << " eigenvalues of modulus > 1 + 1e-8), max|V| "
+                              << sci(pd.absorbing_boundary().statistics().max_update_norm) << std::endl;
+                }
+            return;
+          }
+        Case c = size.find("32") != std::string::npos ? Case{32., 96., 5., 1., 3., 0.5, 48} : ci_case();
+        if (size == "d0")
+          c.damping = 0.;
+        c.n_samples = 48;
+        if (size.rfind("long", 0) == 0)
+          {
+            c.T         = 5000.;
+            c.n_samples = 50;
+            const auto h = run_case(c, c.R, ElasticTruncation::absorbing, prm);
+            if (root())
+              {
+                for (unsigned int s = 0; s < h.times.size(); s += 5)
+                  std::cout << "    t = " << h.times[s] << ": total/E0 " << sci(h.total[s] / h.total[0]) << std::endl;
+                std::cout << "SCAN " << which << ": max|V| " << sci(h.stats.max_update_norm) << ", cond "
+                          << sci(h.stats.max_condition_number) << ", thinned " << h.stats.n_thinned << ", E(5000)/E0 "
+                          << sci(h.total.back() / h.total[0]) << ", max increase between samples "
+                          << sci(max_energy_increase(h)) << std::endl;
+              }
+            return;
+          }
+        // "16o", "32o": the pulse at (R/2, 0).
+        if (size.back() == 'o')
+          c.offset = c.R / 2.;
+        // "16l", "32l": the first-order ABC with the continuum (local) speeds.
+        WaveAbcParameters fo_prm = first_order_parameters();
+        if (size.back() == 'l')
+          fo_prm.dispersion = "local";
+        const auto r = first_order_case(c, prm, fo_prm);
+        if (root())
+          std::cout << "SCAN " << which << ": EBF max " << sci(r.e_ebf) << " T " << sci(r.e_ebf_T) << " field "
+                    << sci(r.f_ebf) << " | FO/EBF max " << r.e_fo / r.e_ebf << " T " << r.e_fo_T / r.e_ebf_T << " field "
+                    << r.f_fo / r.f_ebf << std::endl;
+      }
+    catch (const std::exception &e)
+      {
+        if (root())
+          std::cout << "SCAN " << which << ": " << e.what() << std::endl;
       }
   }
 
@@ -633,9 +925,11 @@ namespace
     check(fails_naming(pml_parameters(0., w, 2.), "PML damping"), "PML damping 0: ParameterError naming 'PML damping'");
     check(fails_naming(pml_parameters(1., 1.5, 2.), "PML thickness"), "PML thickness 1.5 dx: ParameterError naming 'PML thickness'");
     check(fails_naming(pml_parameters(1., w, 0.5), "PML exponent"), "PML exponent 0.5: ParameterError naming 'PML exponent'");
-    WaveAbcParameters first = abc_parameters();
-    first.method            = "first order";
-    check(fails_naming(first, "Method"), "Method = first order (elastic): ParameterError naming 'Method'");
+    // "first order" is a method of the elastic near field since session 18
+    // (elastic_abc.first_order); an unknown method is still refused.
+    WaveAbcParameters unknown = abc_parameters();
+    unknown.method            = "second order";
+    check(fails_naming(unknown, "Method"), "Method = second order (elastic): ParameterError naming 'Method'");
     // A physical free surface (keep filter) or the nonlinear model: refused.
     const auto setup_fails_naming = [&](const bool with_keep, const std::string &name) {
       LatticeParameters lp;
@@ -869,5 +1163,7 @@ main(int argc, char **argv)
               {"pml_long", pml_long},
               {"pml_spectral_radius", pml_spectral_radius},
               {"pml_scan", pml_scan},
-              {"pml_cost", pml_cost}});
+              {"pml_cost", pml_cost},
+              {"first_order", first_order},
+              {"first_order_scan", first_order_scan}});
 }

@@ -25,3 +25,7 @@ perideal_add_test(NAME elastic_abc.tutorial.step-8-pml COMMAND $<TARGET_FILE:ste
 # Dense one-step map (about 4,000 x 4,000): ~40 s, so long.
 perideal_add_test(NAME elastic_abc.spectral_radius COMMAND $<TARGET_FILE:elastic_abc_tests> spectral_radius
   LABELS long TIMEOUT 600)
+# The conventional first-order (Lysmer-type) ABC as the EBF baseline
+# (issue 4; doc/design.md, session 18): E16 at CI size.
+perideal_add_test(NAME elastic_abc.first_order COMMAND $<TARGET_FILE:elastic_abc_tests> first_order
+  LABELS "unit;convergence")

@@ -13,7 +13,9 @@
 // the free (traction-free) and fixed truncations.
 //
 // "Absorbing boundary/Method" selects the truncation of Part 1: ebf (the
-// above), sponge (a damping band, energy-stable but less accurate) or pml
+// above), first order (the conventional Lysmer-type one-way condition on the
+// same layer, the baseline of doc/design.md session 18), sponge (a damping
+// band, energy-stable but less accurate) or pml
 // (a perfectly matched layer of width "PML thickness" beginning where the
 // EBF layer begins, at R - delta: each bond's elongation is complex-stretched
 // along the outward normal with exponential memories; stable without

@@ -99,6 +99,13 @@ namespace PeriDEAL
      * updating blocks per cloud point: u_i^{n+1} = sum_j V_G,j (u_j^n, u_j^{n-1})
      * (4.166). The guards (condition number, max |V|) are enforced by
      * thinning the cloud (Fig. 4.23), else ParameterError.
+     *
+     * With "Method" = "first order" the same update form holds the
+     * conventional baseline instead: the Lysmer-type one-way condition
+     * u^{n+1} = u^n - dt (C du/dn + d u^n), C = c_P n n^T + c_S (I - n n^T)
+     * with the long-wave (k -> 0) P and S speeds of the relation along the
+     * normal n, du/dn from a linear least-squares fit over x_i and the cone
+     * points within min(d_inf, 2 dx); v alike (doc/design.md, session 18).
      */
     class EbfElasticAbc
     {
@@ -196,7 +203,7 @@ namespace PeriDEAL
      * absorbing boundary on the nodes within delta_L of the truncation
      * boundary (Sect. 4.3.5, 4.3.6), or a damping sponge or a PML
      * (ElasticTruncation; ElasticTruncation::absorbing follows
-     * "Absorbing boundary/Method": ebf, sponge or pml); optionally a prescribed-velocity region
+     * "Absorbing boundary/Method": ebf, first order, sponge or pml); optionally a prescribed-velocity region
      * (impact) and pre-cracks. Any number of ranks.
      */
     class PdUnboundedElastic

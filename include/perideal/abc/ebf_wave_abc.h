@@ -167,7 +167,7 @@ namespace PeriDEAL
        * with du/dn from a least-squares linear fit over x_i and the cone
        * points within min(d_inf, 2 dx) (same for v); chi is the long-wave
        * speed of the dispersion relation; "sponge" or "pml" (PD, below).
-       * PdUnboundedElastic takes ebf, sponge or pml.
+       * PdUnboundedElastic takes ebf, first order, sponge or pml.
        */
       std::string method = "ebf";
       /**
