@@ -11,7 +11,10 @@
 //
 // Exploration: WAVES_1D_SCAN="key=value ..." (the EBF keys of
 // tests/wave_settings.h, plus for the FEM h, L, dt, T, scheme=verlet|newmark)
-// with the test names pd_scan_b, pd_scan_c, fem_scan.
+// with the test names pd_scan_b, pd_scan_c, fem_scan; keys rho (one-step
+// spectral radius), vel=1 (FEM Extrapolate velocity), emargin=n (FEM energy
+// without n boundary cells); WAVES_1D_WHERE=dx prints where the PD field
+// error at t_end is (positions scaled by dx).
 
 #include <deal.II/base/function.h>
 
@@ -106,7 +109,15 @@ namespace
           m = std::max(m, std::abs(q.second - ref.fields[s].at(q.first)));
         e.run = std::max(e.run, m / u_max);
         if (s + 1 == h.energy.size())
-          e.end = m / u_max;
+          {
+            e.end = m / u_max;
+            if (std::getenv("WAVES_1D_WHERE") && root())
+              for (const auto &q : h.fields[s])
+                if (std::abs(q.second - ref.fields[s].at(q.first)) >= 0.5 * m)
+                  std::cout << "      x = " << q.first * std::stod(std::getenv("WAVES_1D_WHERE")) << ": u - u_ref = "
+                            << sci(q.second - ref.fields[s].at(q.first)) << ", u_ref = " << sci(ref.fields[s].at(q.first))
+                            << std::endl;
+          }
       }
     return e;
   }
