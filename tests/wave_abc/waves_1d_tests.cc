@@ -302,7 +302,13 @@ namespace
     if (dispersive)
       pd_compare(E12c(), e12c_u0, {{"EBF scan", prm}});
     else
-      pd_compare(E12b(), e12b_u0, {{"EBF scan", prm}});
+      {
+        // dx=: another lattice spacing (same delta) for E12b.
+        E12b b;
+        if (kv.count("dx"))
+          b.lp.dx = std::stod(kv.at("dx"));
+        pd_compare(b, e12b_u0, {{"EBF scan", prm}});
+      }
     if (kv.count("rho"))
       {
         const E12b b;
@@ -310,8 +316,13 @@ namespace
         const double rho = dispersive ?
           one_step_radius_pd(BoxDomain<1>(Point<1>(-c.L), Point<1>(c.L)), c.lp, c.mp, WaveTruncation::absorbing, prm, e12c_u0) :
           one_step_radius_pd(BoxDomain<1>(Point<1>(-b.L), Point<1>(b.L)), b.lp, b.mp, WaveTruncation::absorbing, prm, e12b_u0);
+        auto first       = prm;
+        first.dispersion = "discrete";
+        const double rho_first = dispersive ?
+          one_step_radius_pd(BoxDomain<1>(Point<1>(-c.L), Point<1>(c.L)), c.lp, c.mp, WaveTruncation::first_order, first, e12c_u0) :
+          one_step_radius_pd(BoxDomain<1>(Point<1>(-b.L), Point<1>(b.L)), b.lp, b.mp, WaveTruncation::first_order, first, e12b_u0);
         if (root())
-          std::cout << "    one-step spectral radius - 1 = " << sci(rho - 1.) << std::endl;
+          std::cout << "    one-step spectral radius - 1 = " << sci(rho - 1.) << " (first order " << sci(rho_first - 1.) << ")" << std::endl;
       }
   }
 
