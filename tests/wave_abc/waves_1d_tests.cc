@@ -307,7 +307,10 @@ namespace
         E12b b;
         if (kv.count("dx"))
           b.lp.dx = std::stod(kv.at("dx"));
-        pd_compare(b, e12b_u0, {{"EBF scan", prm}});
+        // w=: pulse exp(-(x/w)^2) (E12b: w = 1).
+        const double w = kv.count("w") ? std::stod(kv.at("w")) : 1.;
+        const ScalarFunctionFromFunctionObject<1> u0([w](const Point<1> &p) { return std::exp(-p[0] * p[0] / (w * w)); });
+        pd_compare(b, u0, {{"EBF scan", prm}});
       }
     if (kv.count("rho"))
       {
