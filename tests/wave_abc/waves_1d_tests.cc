@@ -438,7 +438,7 @@ namespace
 
   /**
    * FEM 1D, h = 0.25, Delta k = 0.5 (fem_scan: Delta k = 1 gives 9.0x at
-   * t_end with Verlet, 0.3-0.6 give 8.5-9.2x at h = 0.5 and 13x at h =
+   * t_end with Verlet at h = 0.25, 0.3-0.6 give 7.6-9.0x at h = 0.5 and 13x at h =
    * 0.25), local relation, default clouds (x_i + 2 DoFs). Measured:
    *   run                      energy    u at t_end  rho - 1
    *   Verlet, first order      2.50e-5   1.49e-3
