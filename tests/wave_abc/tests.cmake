@@ -38,3 +38,9 @@ perideal_add_test(NAME wave_abc.pd_2d_ranks.np2 NPROCS 2
 # step-7 with a reduced near field (radius 6, t_end = 12).
 perideal_add_test(NAME wave_abc.tutorial.step-7 COMMAND $<TARGET_FILE:step-7> ${CMAKE_CURRENT_LIST_DIR}/step-7-ci.prm
   LABELS tutorial)
+# 1D waves (PD E12b/E12c and FEM) against the conventional first-order ABC
+# (4.75) (doc/design.md, session 18, waves1d).
+perideal_add_test_program(waves_1d_tests ${CMAKE_CURRENT_LIST_DIR}/waves_1d_tests.cc)
+foreach(_t pd_1d_first_order fem_1d_first_order)
+  perideal_add_test(NAME wave_abc.${_t} COMMAND $<TARGET_FILE:waves_1d_tests> ${_t} LABELS convergence)
+endforeach()
