@@ -258,11 +258,13 @@ namespace
       for (const auto &e : r)
         if (e.first != "free")
           check(e.second.energy < 0.1 * r.at("free").energy, "E12b " + e.first + ": energy 10x closer than the free truncation");
-      // The gap, asserted as measured: with the source's modes (Delta alpha
-      // = pi/2 < the pulse's band) the EBF is NOT closer than the
-      // first-order ABC at t_end (9.79e-2 vs 4.57e-2).
-      check(f.end < src.end, "E12b gap: the source's n_b = 4 EBF is NOT closer than first order at t_end (" +
-                               sci(src.end) + " vs " + sci(f.end) + ")");
+      // The gap, reported (not asserted: a test must not fail when the EBF
+      // improves): with the source's modes (Delta alpha = pi/2 < the
+      // pulse's band) the EBF is NOT closer than the first-order ABC at
+      // t_end (measured 9.79e-2 vs 4.57e-2).
+      if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+        std::cout << "  E12b gap (reported): the source's n_b = 4 EBF field at t_end " << sci(src.end)
+                  << " vs first order " << sci(f.end) << std::endl;
       // Wide local modes: energy 12.1x (10x asserted; the runs are
       // deterministic, the margin covers round-off only), field at t_end
       // 1.97x (1.5x asserted, 10x NOT reached).
