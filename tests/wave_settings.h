@@ -5,6 +5,7 @@
 // applied on top of a test's Abc::WaveAbcParameters.
 
 #include <perideal/abc/ebf_wave_abc.h>
+#include <perideal/abc/wave_abc_layers.h>
 
 #include <map>
 #include <sstream>
@@ -58,73 +59,29 @@ namespace PeriDEALTests
     return p;
   }
 
-  // Named E14 layers (2D PD waves, m = 6), shared by tests/wave_abc and
-  // contrib/benchmarks/abc_benchmark.cc.
+  // Named E14 layers (2D PD waves, m = 6, dx = 0.25): the library's
+  // Abc::WaveAbcLayers (include/perideal/abc/wave_abc_layers.h, where the
+  // scans behind them are summarized) at the E14 grid spacing.
 
-  /**
-   * A long-run stable EBF layer at m = 6 (doc/design.md, session 13): modes
-   * along the normal only, curved about x_i - R n (R: the disc radius, the
-   * modes are outgoing cylindrical waves), clouds of the points within
-   * 2 dx in the cone of half-angle 1 rad behind x_i (2-4 points), LAPACK's
-   * rcond 1e-4 and the increment form. With the source's cloud (d_inf =
-   * delta) and plane modes the one-step radius is 1 + 1.4e-3; with
-   * d_inf = 3 dx (rcond 1e-5) it is more accurate but the R = 8 disc grows.
-   */
+  /** Abc::WaveAbcLayers::curved_stable (session 13): 2 dx clouds, rcond 1e-4. */
   inline PeriDEAL::Abc::WaveAbcParameters
   e14_stable_parameters(const double disc_radius)
   {
-    PeriDEAL::Abc::WaveAbcParameters prm;
-    prm.dispersion               = "discrete";
-    prm.n_directions             = 0;
-    prm.curvature_radius         = disc_radius;
-    prm.cloud_radius             = 0.5;
-    prm.cone_angle               = 1.;
-    prm.pseudo_inverse_tolerance = 1e-4;
-    prm.fit_form                 = "increment";
-    return prm;
+    return PeriDEAL::Abc::WaveAbcLayers::curved_stable(0.25, disc_radius);
   }
 
-  /**
-   * The session-14 layer: e14_stable_parameters() with the clouds of the
-   * points within 3 dx (0.75; 5-8 points instead of 2-4) and a
-   * Tikhonov-regularized pseudo-inverse, sigma/(sigma^2 + lambda^2) with
-   * lambda = 2e-4 sigma_max. Truncating at rcond 1e-4 or 2e-4 keeps a
-   * singular direction (sigma ~ 2.1e-4 sigma_max) that makes the small discs
-   * grow (R = 2.5: 1 + 2.5e-4), cutting it at 3e-4 costs 4x in accuracy;
-   * the Tikhonov weight halves it, which is stable and keeps most of the
-   * accuracy (doc/design.md, session 14).
-   */
+  /** Abc::WaveAbcLayers::curved_tikhonov (session 14): 3 dx clouds, Tikhonov 2e-4. */
   inline PeriDEAL::Abc::WaveAbcParameters
   e14_tikhonov_parameters(const double disc_radius)
   {
-    PeriDEAL::Abc::WaveAbcParameters prm             = e14_stable_parameters(disc_radius);
-    prm.cloud_radius                  = 0.75;
-    prm.pseudo_inverse_tolerance      = 2e-4;
-    prm.pseudo_inverse_regularization = "tikhonov";
-    return prm;
+    return PeriDEAL::Abc::WaveAbcLayers::curved_tikhonov(0.25, disc_radius);
   }
 
-  /**
-   * The session-15 layer: curved normal modes and the increment form as
-   * e14_stable_parameters(), clouds of the points within 4 dx (1.0) and a
-   * Cone angle Delta phi of 0.4 (the region (4.86) |y| < cot(Delta phi) |x|
-   * behind x_i: half-angle pi/2 - 0.4 = 1.17 rad; 16-20 points), Tikhonov
-   * lambda = 4e-4 sigma_max. From the rough state the (4.99) energy of the
-   * R = 8 disc falls at every step for 113,935 steps and between samples
-   * >= 20 steps apart over 1e6 steps, where the 3 dx
-   * clouds of e14_tikhonov_parameters() (Delta phi 1, 5-8 points) rise to
-   * 130 E0 first; E14 reduced 12x / 23x closer to the reference than first
-   * order (doc/design.md, session 15). The window is narrow: lambda 3.5e-4
-   * rises at 14 of the first 4000 steps, 4.5e-4 falls to 9.9x.
-   */
+  /** Abc::WaveAbcLayers::curved_monotone (session 15): 4 dx clouds, cone 0.4, Tikhonov 4e-4. */
   inline PeriDEAL::Abc::WaveAbcParameters
   e14_monotone_parameters(const double disc_radius)
   {
-    PeriDEAL::Abc::WaveAbcParameters prm             = e14_tikhonov_parameters(disc_radius);
-    prm.cloud_radius                  = 1.;
-    prm.cone_angle                    = 0.4;
-    prm.pseudo_inverse_tolerance      = 4e-4;
-    return prm;
+    return PeriDEAL::Abc::WaveAbcLayers::curved_monotone(0.25, disc_radius);
   }
 
   /**

@@ -39,3 +39,5 @@ perideal_add_test(NAME fem_abc.newmark_q2_stability COMMAND $<TARGET_FILE:fem_ab
 # decay: unit; E13 ratios, the issue's 10x in the field: ~12-25 s, in CI).
 perideal_add_test(NAME fem_abc.newmark_wake_angle_stability COMMAND $<TARGET_FILE:fem_abc_tests> newmark_wake_angle_stability LABELS unit)
 perideal_add_test(NAME fem_abc.newmark_e13_wake_angle COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_wake_angle LABELS convergence TIMEOUT 1200)
+# The same with FE_Q(2) (about 4 min CPU).
+perideal_add_test(NAME fem_abc.newmark_e13_source_size_q2 COMMAND $<TARGET_FILE:fem_abc_tests> newmark_e13_source_size_q2 LABELS "convergence;long" TIMEOUT 2400)
