@@ -12,6 +12,7 @@
 #include <perideal/base/exceptions.h>
 
 #include "../check.h"
+#include "../wave_settings.h"
 
 #include <algorithm>
 #include <cmath>
@@ -278,6 +279,32 @@ namespace
     prm.method            = "first order";
     return prm;
   }
+  /**
+   * One-step spectral radius of the R = 7 disc (dx 1, delta 3 dx, linear
+   * model) with @p prm and @p truncation; @p n_up: eigenvalues of modulus
+   * > 1 + 1e-8.
+   */
+  double
+  disc7_radius(const WaveAbcParameters &prm, const double damping, const double dt, const ElasticTruncation truncation,
+               unsigned int &n_up, double *max_update_norm = nullptr)
+  {
+    LatticeParameters lp;
+    lp.dx    = 1.;
+    lp.delta = 3.;
+    FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+    ElasticWaveParameters          wp;
+    wp.time_step = dt;
+    wp.damping   = damping;
+    PdUnboundedElastic pd(MPI_COMM_SELF);
+    pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, truncation, prm, u0);
+    n_up = 0;
+    const double r = pd.one_step_spectral_radius(4000, &n_up);
+    if (max_update_norm)
+      *max_update_norm = pd.absorbing_boundary().statistics().max_update_norm;
+    return r;
+  }
+
+
 
   /**
    * sum |u - u_ref|^2 / sum |u0|^2 over the compared region at the final
@@ -584,21 +611,11 @@ namespace
     // disc (as spectral_radius for the EBF layer: 1 + 1.5e-2 at d = 0,
     // 1 + 5.0e-3 at d = 0.02). Measured 1 + 3.0e-3 (46 eigenvalues outside)
     // at d = 0, 1 - 7.0e-3 at d = 0.02.
-    LatticeParameters lp;
-    lp.dx    = 1.;
-    lp.delta = 3.;
-    FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
-    std::map<double, double>       radius;
+    std::map<double, double> radius;
     for (const double d : {0., 0.02})
       {
-        ElasticWaveParameters wp;
-        wp.time_step = 0.5;
-        wp.damping   = d;
-        PdUnboundedElastic pd(MPI_COMM_SELF);
-        pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
-                 first_order_parameters(), u0);
         unsigned int n_up = 0;
-        radius[d]         = pd.one_step_spectral_radius(4000, &n_up);
+        radius[d]         = disc7_radius(first_order_parameters(), d, 0.5, ElasticTruncation::absorbing, n_up);
         if (root())
           std::cout << "    first order, R = 7, d = " << d << ": spectral radius - 1 = " << sci(radius[d] - 1.) << " ("
                     << n_up << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
@@ -611,11 +628,13 @@ namespace
           "first order, d = 0: one-step radius 1 + " + sci(radius[0.] - 1.) + " in (1 + 1e-3, 1 + 1e-2)");
   }
 
-  // Exploration (not in CI): E16_FO_SCAN="<mode> [dk nk ndir dphi cone [vmax [tol]]]",
+  // Exploration (not in CI): E16_FO_SCAN="<mode> [key=value ...]" with the
+  // EBF keys of with_wave_settings (tests/wave_settings.h: dk, nk, nphi,
+  // dphi, cone, maxv, tol, ...) on top of abc_parameters();
   // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
   // 16l / 32l (first order with the continuum speeds):
-  // the comparison of first_order_case() with the EBF setting of the optional
-  // keys; sr: one-step radius of the R = 7 disc (first order and that EBF,
+  // the comparison of first_order_case() with that EBF setting;
+  // sr: one-step radius of the R = 7 disc (first order and that EBF,
   // d = 0 and 0.02); long16 / long32: that EBF run alone to t = 5000.
   void
   first_order_scan()
@@ -625,23 +644,9 @@ namespace
     std::istringstream in(which);
     std::string        size;
     in >> size;
-    WaveAbcParameters prm = abc_parameters();
-    double            dk, dphi, cone;
-    unsigned int      nk, ndir;
-    if (in >> dk >> nk >> ndir >> dphi >> cone)
-      {
-        prm.wave_number_range = dk;
-        prm.n_wave_numbers    = nk;
-        prm.n_directions      = ndir;
-        prm.direction_range   = dphi;
-        prm.cone_angle        = cone;
-        double vmax;
-        double tol;
-        if (in >> vmax)
-          prm.max_update_norm = vmax;
-        if (in >> tol)
-          prm.pseudo_inverse_tolerance = tol;
-      }
+    std::string rest;
+    std::getline(in, rest);
+    const WaveAbcParameters prm = PeriDEALTests::with_wave_settings(abc_parameters(), PeriDEALTests::key_values(rest));
     try
       {
         if (size == "sr")
@@ -649,7 +654,6 @@ namespace
             LatticeParameters lp;
             lp.dx    = 1.;
             lp.delta = 3.;
-            FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
             // The long-wave speeds the first-order ABC uses (discrete relation).
             const auto rel = ElasticDispersion::discrete(linear_model(), lp, 1., 0.);
             for (const double phi : {0., M_PI / 8., M_PI / 4.})
@@ -662,19 +666,14 @@ namespace
             for (const bool fo : {true, false})
               for (const double d : {0., 0.02})
                 {
-                  ElasticWaveParameters wp;
-                  wp.time_step = 0.5;
-                  wp.damping   = d;
-                  PdUnboundedElastic pd(MPI_COMM_SELF);
-                  pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
-                           fo ? first_order_parameters() : prm, u0);
                   unsigned int n_up = 0;
-                  const double r    = pd.one_step_spectral_radius(4000, &n_up);
+                  double       vmax = 0.;
+                  const double r    = disc7_radius(fo ? first_order_parameters() : prm, d, 0.5,
+                                                   ElasticTruncation::absorbing, n_up, &vmax);
                   if (root())
                     std::cout << "SCAN " << which << ": " << (fo ? "first order" : "EBF") << ", R = 7, d = " << d
                               << ": spectral radius - 1 = " << sci(r - 1.) << " (" << n_up
-                              << " eigenvalues of modulus > 1 + 1e-8), max|V| "
-                              << sci(pd.absorbing_boundary().statistics().max_update_norm) << std::endl;
+                              << " eigenvalues of modulus > 1 + 1e-8), max|V| " << sci(vmax) << std::endl;
                 }
             return;
           }
@@ -723,21 +722,11 @@ namespace
   void
   spectral_radius()
   {
-    LatticeParameters lp;
-    lp.dx    = 1.;
-    lp.delta = 3.;
-    FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
     std::map<std::pair<double, double>, double> rho;
     for (const auto &[d, dt] : {std::make_pair(0., 0.5), std::make_pair(0.02, 0.5), std::make_pair(0., 0.25)})
       {
-        ElasticWaveParameters wp;
-        wp.time_step = dt;
-        wp.damping   = d;
-        PdUnboundedElastic pd(MPI_COMM_SELF);
-        pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing,
-                 abc_parameters(), u0);
         unsigned int n_up = 0;
-        rho[{d, dt}]      = pd.one_step_spectral_radius(4000, &n_up);
+        rho[{d, dt}]      = disc7_radius(abc_parameters(), d, dt, ElasticTruncation::absorbing, n_up);
         if (root())
           std::cout << "    d = " << d << ", dt = " << dt << ": spectral radius - 1 = " << sci(rho[{d, dt}] - 1.) << " ("
                     << n_up << " eigenvalues of modulus > 1 + 1e-8)" << std::endl;
@@ -777,17 +766,8 @@ namespace
     prm.sponge_damping     = 0.5;
     prm.sponge_exponent    = 2.;
     {
-      LatticeParameters lp;
-      lp.dx    = 1.;
-      lp.delta = 3.;
-      FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
-      ElasticWaveParameters          wp;
-      wp.time_step = 0.5;
-      wp.damping   = 0.;
-      PdUnboundedElastic pd(MPI_COMM_SELF);
-      pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::sponge, prm, u0);
       unsigned int n_up = 0;
-      const double r    = pd.one_step_spectral_radius(4000, &n_up);
+      const double r    = disc7_radius(prm, 0., 0.5, ElasticTruncation::sponge, n_up);
       if (root())
         std::cout << "    sponge, R = 7, d = 0: spectral radius - 1 = " << sci(r - 1.) << " (" << n_up << ")" << std::endl;
       // 1e-12: round-off of the dense eigenproblem (the rigid motions have

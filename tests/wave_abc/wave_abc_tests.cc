@@ -1990,6 +1990,21 @@ namespace
       }
   }
 
+  /** Prints " N:rises" for every N <= n/2 of @p every: samples of @p e every N steps from 0 above the previous one. */
+  void
+  print_sample_rises(const std::vector<double> &e, const unsigned long n, const std::vector<unsigned long> &every)
+  {
+    for (const unsigned long N : every)
+      if (N <= n / 2)
+        {
+          unsigned int ups = 0;
+          for (unsigned long s = N; s <= n; s += N)
+            ups += e[s] > e[s - N];
+          std::cout << " " << N << ":" << ups;
+        }
+    std::cout << std::endl;
+  }
+
   /**
    * Scan of EBF layer settings at m = 6 (E14; not a ctest: a tool for
    * doc/design.md, session 13). Does nothing unless E14_SCAN="key=value ...;
@@ -2224,15 +2239,7 @@ namespace
                 // The shortest sampling interval (of these) at which every
                 // sample from step 0 is below the previous one.
                 std::cout << "      samples every N steps from 0 with E up:";
-                for (const unsigned long every : {1ul, 10ul, 20ul, 50ul, 100ul, 200ul, 500ul, 1000ul, 10000ul})
-                  if (every <= n / 2)
-                    {
-                      unsigned int ups = 0;
-                      for (unsigned long s = every; s <= n; s += every)
-                        ups += e[s] > e[s - every];
-                      std::cout << " " << every << ":" << ups;
-                    }
-                std::cout << std::endl;
+                print_sample_rises(e, n, {1ul, 10ul, 20ul, 50ul, 100ul, 200ul, 500ul, 1000ul, 10000ul});
               }
             catch (const std::exception &ex)
               {
@@ -2517,15 +2524,7 @@ namespace
               std::cout << "    rough state R = " << Rl << ", " << n << " steps: peak E/E0 " << sci(e[peak_step] / e[0])
                         << " at step " << peak_step << ", E_end/E0 " << sci(e.back() / e[0]) << ", steps with E up " << n_up
                         << " (first " << first_up << ", largest " << sci(max_rel) << "); samples every N from 0 up:";
-              for (const unsigned long every : {10ul, 100ul, 1000ul})
-                if (every <= n / 2)
-                  {
-                    unsigned int ups = 0;
-                    for (unsigned long s = every; s <= n; s += every)
-                      ups += e[s] > e[s - every];
-                    std::cout << " " << every << ":" << ups;
-                  }
-              std::cout << std::endl;
+              print_sample_rises(e, n, {10ul, 100ul, 1000ul});
             }
           catch (const std::exception &ex)
             {
