@@ -37,7 +37,8 @@ namespace PeriDEAL
                       "Thickness of the layer of constrained (Dirichlet) nodes added "
                       "outside the body; 0: none (homogeneous nonlocal Neumann by "
                       "omission of missing neighbours); a negative value means the "
-                      "horizon delta.");
+                      "reach of the bonds: delta + dx/2 with partial volumes, "
+                      "delta without.");
     prm.declare_entry("Node order", "cells", Patterns::Selection("cells|lattice"),
                       "Local numbering of the owned nodes: cells (the octree's "
                       "space-filling curve, lattice order within a cell) or lattice "
@@ -65,8 +66,11 @@ namespace PeriDEAL
     partial_volume = prm.get_bool("Partial volume");
     cell_centered  = (prm.get("Lattice") == "cell centered");
     layer_thickness = prm.get_double("Volume constraint layer");
+    // The constraint layer must hold every node a body node is bonded to:
+    // with partial volumes (3.2) that reaches delta + dx/2, which a layer
+    // of delta misses at convex corners (e.g. the (3, 1) dx bond at m = 3).
     if (layer_thickness < 0.)
-      layer_thickness = delta;
+      layer_thickness = partial_volume ? delta + 0.5 * dx : delta;
     lattice_order = (prm.get("Node order") == "lattice");
   }
 

@@ -177,7 +177,10 @@ namespace PeriDEAL
   bool
   BoxDomain<dim>::inside(const Point<dim> &p) const
   {
-    return signed_distance(p) <= 0.;
+    // Lattice points on a face come out of origin + i dx with round-off of
+    // either sign (the origin moves with the layer thickness); they belong
+    // to the body.
+    return signed_distance(p) <= 1e-12 * lower.distance(upper);
   }
 
   template <int dim>

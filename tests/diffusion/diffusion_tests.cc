@@ -257,9 +257,10 @@ namespace
     const auto box  = count(" set Domain = box\n set Lower corner = -0.5, -0.5\n set Upper corner = 0.5, 0.5\n");
     const auto cube = count(" set Domain = mesh\n set Grid generator = hyper_cube\n set Grid arguments = -0.5 : 0.5 : false\n");
     const auto gmsh = count(" set Domain = mesh\n set Mesh file = square.msh\n");
-    // 21 x 21 body nodes; layer = 4 edge strips of 21 x 3 plus, per corner,
-    // the offsets (a, b) in 1..3 with a^2 + b^2 <= 9: (1,1) (1,2) (2,1) (2,2).
-    check(box.first == 21 * 21 + box.second && box.second == 4 * 21 * 3 + 4 * 4,
+    // 21 x 21 body nodes; the layer (-1: the bonds' reach delta + dx/2 =
+    // 3.5 dx) = 4 edge strips of 21 x 3 plus, per corner, the offsets
+    // (a, b) >= 1 with a^2 + b^2 <= 12.25: (1,1) (1,2) (2,1) (2,2) (1,3) (3,1).
+    check(box.first == 21 * 21 + box.second && box.second == 4 * 21 * 3 + 4 * 6,
           "box: " + std::to_string(box.first) + " nodes, " + std::to_string(box.second) + " in the layer");
     check(cube == box, "GridGenerator hyper_cube body = box: " + std::to_string(cube.first) + " / " +
                          std::to_string(cube.second));
