@@ -38,7 +38,8 @@ namespace PeriDEAL
                       "outside the body; 0: none (homogeneous nonlocal Neumann by "
                       "omission of missing neighbours); a negative value means the "
                       "reach of the bonds: delta + dx/2 with partial volumes, "
-                      "delta without.");
+                      "delta without (a thinner layer leaves out bonds at "
+                      "convex corners).");
     prm.declare_entry("Node order", "cells", Patterns::Selection("cells|lattice"),
                       "Local numbering of the owned nodes: cells (the octree's "
                       "space-filling curve, lattice order within a cell) or lattice "
