@@ -635,7 +635,7 @@ namespace
   // 16l / 32l (first order with the continuum speeds):
   // the comparison of first_order_case() with that EBF setting;
   // sr: one-step radius of the R = 7 disc (first order and that EBF,
-  // d = 0 and 0.02); long16 / long32: that EBF run alone to t = 5000.
+  // d = 0 and 0.02); sre: the EBF's alone at d = 0.02 (with " d0" also d = 0); long16 / long32: that EBF run alone to t = 5000.
   void
   first_order_scan()
   {
@@ -649,6 +649,23 @@ namespace
     const WaveAbcParameters prm = PeriDEALTests::with_wave_settings(abc_parameters(), PeriDEALTests::key_values(rest));
     try
       {
+        if (size == "sre")
+          {
+            // The EBF layer alone at d = 0.02 (d0: also d = 0).
+            for (const double d : {0.02, 0.})
+              {
+                if (d == 0. && which.find(" d0") == std::string::npos)
+                  continue;
+                unsigned int n_up = 0;
+                double       vmax = 0.;
+                const double r = disc7_radius(prm, d, 0.5, ElasticTruncation::absorbing, n_up, &vmax);
+                if (root())
+                  std::cout << "SCAN " << which << ": EBF, R = 7, d = " << d << ": spectral radius - 1 = "
+                            << sci(r - 1.) << " (" << n_up << " eigenvalues of modulus > 1 + 1e-8), max|V| "
+                            << sci(vmax) << std::endl;
+              }
+            return;
+          }
         if (size == "sr")
           {
             LatticeParameters lp;
