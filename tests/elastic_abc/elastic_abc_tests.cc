@@ -446,12 +446,15 @@ namespace
     Case c      = ci_case();
     c.T         = 24.;
     c.n_samples = 2;
-    for (const std::string method : {"ebf", "pml", "first order"})
+    // "curved": the preset ElasticAbcLayers::curved_tikhonov (session 19).
+    for (const std::string method : {"ebf", "pml", "first order", "curved"})
       {
         const bool        with_pml = method == "pml";
-        const std::string name     = with_pml ? "PML" : method == "ebf" ? "EBF" : "first order";
-        const auto        prm      = with_pml ? pml_parameters(1., 6., 2.) : method == "ebf" ? abc_parameters() :
-                                                                                                 first_order_parameters();
+        const std::string name     = with_pml ? "PML" : method == "ebf" ? "EBF" : method == "curved" ? "EBF curved_tikhonov" : "first order";
+        const auto        prm      = with_pml              ? pml_parameters(1., 6., 2.) :
+                                     method == "ebf"       ? abc_parameters() :
+                                     method == "curved"    ? ElasticAbcLayers::curved_tikhonov(c.dx, c.R) :
+                                                             first_order_parameters();
         const double      radius = with_pml ? c.R + 3. : c.R;
         const auto        all    = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_WORLD);
         const auto        self   = run_case(c, radius, ElasticTruncation::absorbing, prm, MPI_COMM_SELF);
