@@ -696,7 +696,7 @@ namespace
   // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
   // 16l / 32l (first order with the continuum speeds):
   // the comparison of first_order_case() with that EBF setting;
-  // keys w=, T=: pulse width, final time; key "preset": on top of ElasticAbcLayers::curved_tikhonov (session 19);
+  // keys w=, T=: pulse width, final time; ns=: samples of long16 / long32; key "preset": on top of ElasticAbcLayers::curved_tikhonov (session 19);
   // sr: one-step radius of the R = 7 disc (first order and that EBF,
   // d = 0 and 0.02); sre: the EBF's alone at d = 0.02 (with " d0" also d = 0); long16 / long32: that EBF run alone to t = 5000.
   void
@@ -775,11 +775,23 @@ namespace
         if (size.rfind("long", 0) == 0)
           {
             c.T         = 5000.;
-            c.n_samples = 50;
+            // Key ns=: number of samples (10000: every step).
+            c.n_samples  = kv.count("ns") ? std::stoi(kv.at("ns")) : 50;
             const auto h = run_case(c, c.R, ElasticTruncation::absorbing, prm);
             if (root())
               {
-                for (unsigned int s = 0; s < h.times.size(); s += 5)
+                // Samples after which the total / Verlet energy rose.
+                unsigned int n_rise = 0, n_rise_verlet = 0, first_rise = 0;
+                for (unsigned int s = 1; s < h.times.size(); ++s)
+                  {
+                    if (h.total[s] > h.total[s - 1] && n_rise++ == 0)
+                      first_rise = s;
+                    n_rise_verlet += h.verlet[s] > h.verlet[s - 1] ? 1 : 0;
+                  }
+                std::cout << "SCAN " << which << ": rises between samples: total " << n_rise << " (first at t = "
+                          << (n_rise ? h.times[first_rise] : 0.) << "), Verlet " << n_rise_verlet
+                          << ", max Verlet increase " << sci(max_energy_increase(h, true)) << std::endl;
+                for (unsigned int s = 0; s < h.times.size(); s += h.times.size() / 10)
                   std::cout << "    t = " << h.times[s] << ": total/E0 " << sci(h.total[s] / h.total[0]) << std::endl;
                 std::cout << "SCAN " << which << ": max|V| " << sci(h.stats.max_update_norm) << ", cond "
                           << sci(h.stats.max_condition_number) << ", thinned " << h.stats.n_thinned << ", E(5000)/E0 "
