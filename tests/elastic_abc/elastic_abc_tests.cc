@@ -450,7 +450,10 @@ namespace
     for (const std::string method : {"ebf", "pml", "first order", "curved"})
       {
         const bool        with_pml = method == "pml";
-        const std::string name     = with_pml ? "PML" : method == "ebf" ? "EBF" : method == "curved" ? "EBF curved_tikhonov" : "first order";
+        const std::string name     = with_pml              ? "PML" :
+                                     method == "ebf"       ? "EBF" :
+                                     method == "curved"    ? "EBF curved_tikhonov" :
+                                                             "first order";
         const auto        prm      = with_pml              ? pml_parameters(1., 6., 2.) :
                                      method == "ebf"       ? abc_parameters() :
                                      method == "curved"    ? ElasticAbcLayers::curved_tikhonov(c.dx, c.R) :
@@ -697,9 +700,11 @@ namespace
   // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
   // 16l / 32l (first order with the continuum speeds):
   // the comparison of first_order_case() with that EBF setting;
-  // keys w=, T=: pulse width, final time; ns=: samples of long16 / long32; key "preset": on top of ElasticAbcLayers::curved_tikhonov (session 19);
+  // keys w=, T=: pulse width, final time; ns=: samples of long16 / long32;
+  // key "preset": on top of ElasticAbcLayers::curved_tikhonov (session 19);
   // sr: one-step radius of the R = 7 disc (first order and that EBF,
-  // d = 0 and 0.02); sre: the EBF's alone at d = 0.02 (with " d0" also d = 0); long16 / long32: that EBF run alone to t = 5000.
+  // d = 0 and 0.02); sre: the EBF's alone at d = 0.02 (with " d0" also
+  // d = 0); long16 / long32: that EBF run alone to t = 5000.
   void
   first_order_scan()
   {
