@@ -665,6 +665,36 @@ namespace
         // Damped runs: the total energy of the near field falls between samples.
         check(r.ebf_growth <= 0., name + "total energy non-increasing between samples (" + sci(r.ebf_growth) + ")");
       }
+    // Bad settings of the session-19 options name their parameter.
+    const auto fails_naming = [](const WaveAbcParameters &bad, const std::string &name) {
+      LatticeParameters lp;
+      lp.dx    = 1.;
+      lp.delta = 3.;
+      ElasticWaveParameters wp;
+      wp.time_step = 0.5;
+      FunctionFromFunctionObjects<2> u0({[](const Point<2> &) { return 0.; }, [](const Point<2> &) { return 0.; }});
+      PdUnboundedElastic pd(MPI_COMM_SELF);
+      try
+        {
+          pd.setup(BallDomain<2>(Point<2>(), 7.), lp, linear_model(), wp, ElasticTruncation::absorbing, bad, u0);
+        }
+      catch (const ParameterError &e)
+        {
+          return std::string(e.what()).find(name) != std::string::npos;
+        }
+      return false;
+    };
+    WaveAbcParameters bad = ElasticAbcLayers::curved_tikhonov(1., 7.);
+    bad.fit_form          = "slope";
+    check(fails_naming(bad, "Fit form"), "Fit form = slope: ParameterError naming 'Fit form'");
+    bad                          = ElasticAbcLayers::curved_tikhonov(1., 7.);
+    bad.pseudo_inverse_tolerance = 0.;
+    check(fails_naming(bad, "Pseudo-inverse regularization"),
+          "tikhonov without a tolerance: ParameterError naming 'Pseudo-inverse regularization'");
+    // Curvature radius 2 < the cloud radius delta = 3.
+    check(fails_naming(ElasticAbcLayers::curved_tikhonov(1., 2.), "Curvature radius"),
+          "Curvature radius 2 <= cloud radius 3: ParameterError naming 'Curvature radius'");
+
     // (c) One-step radius of the R = 7 disc at d = 0.02 (curvature 7):
     // measured 1 - 6.0e-3 (the default: 1 + 5.0e-3); 1e-12: round-off of
     // the dense eigenproblem.
