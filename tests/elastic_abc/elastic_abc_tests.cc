@@ -730,7 +730,7 @@ namespace
   // mode 16, 32 (E16 sizes), d0 (16 undamped), 16o / 32o (pulse at (R/2, 0)),
   // 16l / 32l (first order with the continuum speeds):
   // the comparison of first_order_case() with that EBF setting;
-  // keys w=, T=: pulse width, final time; ns=: samples of long16 / long32;
+  // keys w=, T=, dt=: pulse width, final time, time step; ns=: samples of long16 / long32;
   // key "preset": on top of ElasticAbcLayers::curved_tikhonov (session 19);
   // sr: one-step radius of the R = 7 disc (first order and that EBF,
   // d = 0 and 0.02); sre: the EBF's alone at d = 0.02 (with " d0" also
@@ -807,6 +807,8 @@ namespace
           c.w = std::stod(kv.at("w"));
         if (kv.count("T"))
           c.T = std::stod(kv.at("T"));
+        if (kv.count("dt"))
+          c.dt = std::stod(kv.at("dt"));
         c.n_samples = 48;
         if (size.rfind("long", 0) == 0)
           {
