@@ -143,6 +143,40 @@ namespace PeriDEAL
     }
 
 
+    namespace
+    {
+      /**
+       * V = Psi M^+ as pseudo_inverse_fit() (ebf_cloud.cc), optionally with
+       * the Tikhonov weight sigma/(sigma^2 + lambda^2), lambda = tolerance
+       * sigma_max, instead of the truncation (as the scalar EbfWaveAbc's
+       * fit, doc/design.md session 14; a local copy, ebf_cloud is shared).
+       */
+      PseudoInverseFit
+      elastic_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance,
+                  const bool tikhonov)
+      {
+        if (!tikhonov)
+          return pseudo_inverse_fit(M, psi, tolerance);
+        PseudoInverseFit                      f;
+        const Eigen::BDCSVD<Eigen::MatrixXcd> svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
+        const auto                           &sv  = svd.singularValues();
+        const double cut = std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon();
+        Eigen::Index rank = 0;
+        while (rank < sv.size() && sv[rank] > cut * sv[0])
+          ++rank;
+        Eigen::VectorXd inverse(rank);
+        for (Eigen::Index q = 0; q < rank; ++q)
+          inverse[q] = sv[q] / (sv[q] * sv[q] + tolerance * tolerance * sv[0] * sv[0]);
+        const Eigen::MatrixXcd Vc =
+          ((psi * svd.matrixV().leftCols(rank)) * inverse.asDiagonal()) * svd.matrixU().leftCols(rank).adjoint();
+        f.V                = Vc.real();
+        f.condition_number = rank > 0 ? sv[0] / std::max(sv[rank - 1], tolerance * sv[0]) :
+                                        std::numeric_limits<double>::infinity();
+        f.max_norm         = Vc.cwiseAbs().maxCoeff();
+        return f;
+      }
+    } // namespace
+
     void
     EbfElasticAbc::reinit(const std::vector<Point<2>>                &points,
                           const std::vector<types::global_dof_index> &ids,
@@ -162,6 +196,17 @@ namespace PeriDEAL
                       "Absorbing boundary/Wave number range", prm.wave_number_range,
                       "0 < Delta k <= pi/dx = " + std::to_string(M_PI / dx) + " (4.167)");
       check_parameter(prm.cloud_radius > 0., "Absorbing boundary/Cloud radius", prm.cloud_radius, "> 0");
+      check_parameter(prm.fit_form == "value" || prm.fit_form == "increment", "Absorbing boundary/Fit form",
+                      prm.fit_form, "value or increment");
+      check_parameter(prm.pseudo_inverse_regularization == "truncate" ||
+                        (prm.pseudo_inverse_regularization == "tikhonov" && prm.pseudo_inverse_tolerance > 0.),
+                      "Absorbing boundary/Pseudo-inverse regularization", prm.pseudo_inverse_regularization,
+                      "truncate, or tikhonov with a Pseudo-inverse tolerance > 0");
+      check_parameter(prm.curvature_radius == 0. || prm.curvature_radius > prm.cloud_radius,
+                      "Absorbing boundary/Curvature radius", prm.curvature_radius,
+                      "0 (plane modes) or > the cloud radius " + std::to_string(prm.cloud_radius));
+      const bool increment = prm.fit_form == "increment";
+      const bool tikhonov  = prm.pseudo_inverse_regularization == "tikhonov";
       absorbing = absorbing_in;
       cloud_start.assign(1, 0);
       cloud_index.clear();
@@ -288,6 +333,35 @@ namespace PeriDEAL
                 }
             }
           const auto cone = builder.cone(i, R);
+          // Curved wave fronts (curvature_radius rho > 0, as the scalar
+          // EbfWaveAbc): every mode is evaluated in the polar coordinates
+          // about x_i - rho n, s = (r - rho, rho theta), with the
+          // cylindrical amplitude sqrt(rho / r), and its polarization turns
+          // with the local radial direction (a P mode along the normal stays
+          // radial, an S mode tangential): outgoing cylindrical P and S waves.
+          const double rho_c = prm.curvature_radius;
+          const auto   mode  = [&](const Tensor<1, 2> &xbar, const double time, const unsigned int c,
+                                  const unsigned int q) {
+            Tensor<1, 2> s = xbar, g = gamma[c];
+            double       amplitude = 1.;
+            if (rho_c > 0.)
+              {
+                Tensor<1, 2> from_centre = xbar;
+                from_centre[0] += rho_c;
+                const double radius = from_centre.norm();
+                const double theta  = std::atan2(from_centre[1], from_centre[0]);
+                s[0]                = radius - rho_c;
+                s[1]                = rho_c * theta;
+                amplitude           = std::sqrt(rho_c / radius);
+                // gamma in the local frame, turned by theta, back to global.
+                const Tensor<1, 2> gl = R * g;
+                Tensor<1, 2>       gr;
+                gr[0] = std::cos(theta) * gl[0] - std::sin(theta) * gl[1];
+                gr[1] = std::sin(theta) * gl[0] + std::cos(theta) * gl[1];
+                g     = transpose(R) * gr;
+              }
+            return amplitude * g[q] * std::exp(I * (kv[c] * s) + rate[c] * time);
+          };
 
           PseudoInverseFit fg, fh;
           bool             ok     = false;
@@ -303,29 +377,37 @@ namespace PeriDEAL
               Eigen::MatrixXcd psi_g(2, n_cols), psi_h(2, n_cols);
               for (unsigned int c = 0; c < n_cols; ++c)
                 {
-                  const std::complex<double> step = std::exp(rate[c] * dt);
                   for (unsigned int p = 0; p < 2; ++p)
                     {
-                      psi_g(p, c) = gamma[c][p] * step;
+                      psi_g(p, c) = mode(Tensor<1, 2>(), dt, c, p);
+                      // Increment form: the fit extrapolates the change over
+                      // one step (x_i's level-n value is added back below).
+                      if (increment)
+                        psi_g(p, c) -= mode(Tensor<1, 2>(), 0., c, p);
                       psi_h(p, c) = rate[c] * psi_g(p, c);
                     }
                   for (unsigned int j = 0; j < cloud.size(); ++j)
-                    {
-                      const std::complex<double> space = std::exp(I * (kv[c] * cloud[j].second));
-                      for (unsigned int s = 0; s < 2; ++s)
+                    for (unsigned int s = 0; s < 2; ++s)
+                      for (unsigned int q = 0; q < 2; ++q)
                         {
-                          const std::complex<double> level =
-                            s < prm.n_time_levels ? space * std::exp(-rate[c] * (s * dt)) : 0.;
-                          for (unsigned int q = 0; q < 2; ++q)
-                            {
-                              MG(4 * j + 2 * q + s, c) = gamma[c][q] * level;
-                              MH(4 * j + 2 * q + s, c) = rate[c] * MG(4 * j + 2 * q + s, c);
-                            }
+                          MG(4 * j + 2 * q + s, c) =
+                            s < prm.n_time_levels ? mode(cloud[j].second, -double(s) * dt, c, q) : 0.;
+                          MH(4 * j + 2 * q + s, c) = rate[c] * MG(4 * j + 2 * q + s, c);
                         }
-                    }
                 }
-              fg = pseudo_inverse_fit(MG, psi_g, prm.pseudo_inverse_tolerance);
-              fh = pseudo_inverse_fit(MH, psi_h, prm.pseudo_inverse_tolerance);
+              fg = elastic_fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
+              fh = elastic_fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
+              if (increment)
+                {
+                  // + e_i: cloud[0] = x_i, column 2 p = component p at level n.
+                  for (unsigned int p = 0; p < 2; ++p)
+                    {
+                      fg.V(p, 2 * p) += 1.;
+                      fh.V(p, 2 * p) += 1.;
+                    }
+                  fg.max_norm = fg.V.cwiseAbs().maxCoeff();
+                  fh.max_norm = fh.V.cwiseAbs().maxCoeff();
+                }
               ok = fg.condition_number <= prm.max_condition_number &&
                    fh.condition_number <= prm.max_condition_number &&
                    fg.max_norm <= prm.max_update_norm && fh.max_norm <= prm.max_update_norm;

@@ -29,3 +29,7 @@ perideal_add_test(NAME elastic_abc.spectral_radius COMMAND $<TARGET_FILE:elastic
 # (issue 4; doc/design.md, session 18): E16 at CI size.
 perideal_add_test(NAME elastic_abc.first_order COMMAND $<TARGET_FILE:elastic_abc_tests> first_order
   LABELS "unit;convergence")
+# One EBF setting >= 10x closer than the first-order ABC on both E16
+# sizes, long-run stable (ElasticAbcLayers::curved_tikhonov; session 19).
+perideal_add_test(NAME elastic_abc.curved_tikhonov COMMAND $<TARGET_FILE:elastic_abc_tests> curved_tikhonov
+  LABELS convergence)
