@@ -422,7 +422,10 @@ namespace
     LatticeParameters lp;
     lp.dx              = delta / 3.;
     lp.delta           = delta;
-    lp.layer_thickness = delta;
+    // The layer must hold every bond of the boundary rows, including the
+    // partial-volume shell up to delta + dx/2 (the layer is the set of
+    // nodes within this distance of the box: rounded at the corners).
+    lp.layer_thickness = delta + 0.5 * lp.dx;
     Point<dim> lo, hi;
     for (unsigned int d = 0; d < dim; ++d)
       hi[d] = 1.;
