@@ -190,14 +190,16 @@ namespace
   }
 
   // Max error of the discrete operator (migration or diffusion term) over
-  // the nodes with |x|_inf <= 0.25 of the box (-0.5, 0.5)^dim (full families).
+  // the nodes with |x|_inf <= inner of a box large enough for their
+  // families to be full.
   template <int dim>
   double
   discrete_error(const double                        delta,
                  const unsigned int                  m,
                  const std::string                  &calibration,
                  const typename NnppOperator<dim>::Terms terms,
-                 const double                        q)
+                 const double                        q,
+                 const double                        inner = 0.25)
   {
     LatticeParameters lp;
     lp.dx    = delta / m;
@@ -205,8 +207,8 @@ namespace
     Point<dim> lo, hi;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        lo[d] = -0.5;
-        hi[d] = 0.5;
+        lo[d] = -(inner + delta + lp.dx);
+        hi[d] = inner + delta + lp.dx;
       }
     BoxDomain<dim>      box(lo, hi);
     Discretization<dim> disc(MPI_COMM_WORLD);
@@ -229,10 +231,10 @@ namespace
     double err = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
-        bool inner = true;
+        bool is_inner = true;
         for (unsigned int d = 0; d < dim; ++d)
-          inner = inner && std::abs(disc.position[i][d]) <= 0.25 + 1e-12;
-        if (!inner)
+          is_inner = is_inner && std::abs(disc.position[i][d]) <= inner + 1e-12;
+        if (!is_inner)
           continue;
         const double exact = terms == NnppOperator<dim>::Terms::migration ?
                                div_c_grad_phi(disc.position[i]) :
@@ -288,26 +290,107 @@ namespace
     using T1 = NnppOperator<1>::Terms;
     for (const double q : {0., 0.5})
       {
-        std::vector<double> em, ed, ec, em1;
+        std::vector<double> em, ed, ec, em1, em3;
         for (const double delta : {0.2, 0.1, 0.05})
           {
             em.push_back(discrete_error<2>(delta, 3, "discrete", T2::migration, q));
             ed.push_back(discrete_error<2>(delta, 3, "discrete", T2::diffusion, q));
             ec.push_back(discrete_error<2>(delta, 3, "continuous", T2::migration, q));
             em1.push_back(discrete_error<1>(delta, 3, "discrete", T1::migration, q));
+            em3.push_back(discrete_error<3>(delta, 3, "discrete", NnppOperator<3>::Terms::migration, q, 0.1));
           }
         auto rate = [](const std::vector<double> &e) { return std::log2(e[1] / e[2]); };
         if (root())
           std::cout << "  discrete m = 3, q = " << q << ": 2D migration " << sci(em[0]) << " "
                     << sci(em[1]) << " " << sci(em[2]) << " (rate " << rate(em)
                     << "), 2D diffusion rate " << rate(ed) << ", 1D migration " << sci(em1[2])
-                    << " (rate " << rate(em1) << "); continuous constants: " << sci(ec[0])
+                    << " (rate " << rate(em1) << "), 3D migration " << sci(em3[2]) << " (rate " << rate(em3)
+                    << "); continuous constants: " << sci(ec[0])
                     << " " << sci(ec[1]) << " " << sci(ec[2]) << std::endl;
         // Expected 2 (consistent O(delta^2) truncation error); 1.8 allows the
         // pre-asymptotic lattice terms at m = 3.
         check(rate(em) > 1.8, "2D discrete migration, discrete calibration: rate ~2");
         check(rate(ed) > 1.8, "2D discrete diffusion, discrete calibration: rate ~2");
         check(rate(em1) > 1.8, "1D discrete migration, discrete calibration: rate ~2");
+        check(rate(em3) > 1.8, "3D discrete migration, discrete calibration: rate ~2");
+      }
+  }
+
+  // The frozen Jacobian against the residual: for fixed phi the species
+  // residual (3.11) is affine in C, so J v = v/dt - L_k v exactly (v = 0 on
+  // the layer). With the sign of K1 in (3.15) as printed, the off-diagonal
+  // diffusion entries would have the wrong sign and this fails by O(1).
+  template <int dim>
+  void
+  jacobian_case(const std::string &boundary)
+  {
+    LatticeParameters lp;
+    lp.dx              = 0.1;
+    lp.delta           = 0.3;
+    lp.layer_thickness = lp.delta + 0.5 * lp.dx;
+    Point<dim> lo, hi;
+    for (unsigned int d = 0; d < dim; ++d)
+      hi[d] = 1.;
+    BoxDomain<dim>      box(lo, hi);
+    Discretization<dim> disc(MPI_COMM_WORLD);
+    disc.setup(box, lp);
+    NnppParameters p;
+    p.valence          = {1., -2.};
+    p.diffusivity      = {{{1., 0.2, 0.05}}, {{0.4, 0.1, 0.}}};
+    p.conductivity     = {{1., 0.5, 0.1}};
+    p.q1               = 0.25;
+    p.q2               = -0.5;
+    p.faraday          = 2.;
+    p.species_boundary = boundary;
+    NnppOperator<dim> op(disc, p);
+    PeriDEAL::Vector  phi, phase, v, rate;
+    for (auto *x : {&phi, &phase, &v, &rate})
+      disc.initialize_vector(*x);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        const auto &x        = disc.position[i];
+        phi.local_element(i) = std::sin(3. * x[0]) + x[dim - 1];
+        phase.local_element(i) = x[0] > 0.45 ? 1. : 0.;
+        v.local_element(i) = disc.region[i] == Discretization<dim>::interior ?
+                               std::cos(7.3 * x[0] + 2.1 * x[dim - 1] + 0.3 * disc.id[i]) :
+                               0.;
+      }
+    for (auto *x : {&phi, &phase, &v})
+      x->update_ghost_values();
+    const double dt = 0.01;
+    const auto   owned = disc.partitioner()->locally_owned_range();
+    double       diff = 0., scale = 0.;
+    for (unsigned int k = 0; k < 2; ++k)
+      {
+        TrilinosWrappers::SparseMatrix J;
+        op.assemble_species_jacobian(k, phi, dt, J, &phase);
+        TrilinosWrappers::MPI::Vector tv(owned, MPI_COMM_WORLD), jv(owned, MPI_COMM_WORLD);
+        std::copy(v.begin(), v.begin() + disc.n_owned(), tv.begin());
+        J.vmult(jv, tv);
+        op.apply_species(k, v, phi, rate, &phase);
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (disc.region[i] == Discretization<dim>::interior)
+            {
+              const double expected = v.local_element(i) / dt - rate.local_element(i);
+              diff  = std::max(diff, std::abs(jv.begin()[i] - expected));
+              scale = std::max(scale, std::abs(expected));
+            }
+      }
+    diff  = Utilities::MPI::max(diff, MPI_COMM_WORLD);
+    scale = Utilities::MPI::max(scale, MPI_COMM_WORLD);
+    // Same sums in a different order: round-off of O(100) terms.
+    check(diff <= 1e-12 * scale, std::to_string(dim) + "D " + boundary +
+                                   ": Jacobian (3.14)-(3.15, corrected) = dF/dC, max diff " +
+                                   sci(diff) + " of " + sci(scale));
+  }
+
+  void
+  jacobian()
+  {
+    for (const std::string b : {"closed", "dirichlet"})
+      {
+        jacobian_case<1>(b);
+        jacobian_case<2>(b);
       }
   }
 
@@ -507,18 +590,26 @@ namespace
     BoxDomain<2>      box(Point<2>(-1., -0.5), Point<2>(1., 0.5));
     Discretization<2> disc(MPI_COMM_WORLD);
     disc.setup(box, lp);
-    NnppParameters p;
-    p.valence      = {2., -1.};
-    p.diffusivity  = {{{1., 0.1, 0.}}, {{0.7, 0.05, 0.01}}};
-    p.conductivity = {{1., 0.5, 0.2}};
-    p.q1 = 0.;
-    p.q2 = 0.25;
-    p.q3 = -0.5;
-    p.faraday = 1.;
-    p.gas_constant = p.temperature = 1.;
-    p.time_step        = 0.01;
-    p.newton_tolerance = 1e-14; // mass defect ~ dt sum V F: far below 1e-12
-    p.linear_tolerance = 1e-10;
+    // Read through the ParameterHandler path ("NNPP" subsection).
+    const auto p = parameters_from_text<NnppParameters>(R"(
+subsection NNPP
+  set Valences = 2, -1
+  set Diffusivities = 1, 0.7
+  set Interface diffusivities = 0.1, 0.05
+  set Solid diffusivities = 0, 0.01
+  set Conductivities = 1, 0.5, 0.2
+  set Diffusion exponent q1 = 0
+  set Migration exponent q2 = 0.25
+  set Poisson exponent q3 = -0.5
+  set Faraday constant = 1
+  set Gas constant = 1
+  set Temperature = 1
+  set Time step = 0.01
+  set Newton tolerance = 1e-14
+  set Linear solver tolerance = 1e-10
+end
+)");
+    // Newton tolerance 1e-14: the mass defect is ~ dt sum_i V_i F_i.
     NnppSources<2> src;
     src.boundary_potential = [](const Point<2> &x, double) { return 0.5 * x[0]; };
     NnppSolver<2> s(disc, p, src);
@@ -577,6 +668,10 @@ namespace
         std::cout << "  " << found << " of " << self.size() << " nodes compared, max diff "
                   << sci(diff) << " (max |field| " << sci(scale) << ")" << std::endl;
         check(found == self.size(), "every node found on both partitions");
+        bool all_own = true;
+        for (const auto &part : world_all)
+          all_own = all_own && !part.empty();
+        check(all_own, "every rank owns interior nodes");
         // Different partitions change only the order of CG/GMRES/AMG
         // operations: the fields agree to the solver tolerances (1e-12).
         check(diff <= 1e-12 * scale, "1 vs n ranks: same fields to 1e-12");
@@ -618,6 +713,10 @@ end
                  "NNPP/Time step", "dt < 0");
     expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Conductivities = 1, 0\n")); },
                  "NNPP/Conductivities", "two conductivities");
+    expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Conductivities = 1, 0.5, 0\n")); },
+                 "NNPP/Conductivities", "zero solid conductivity");
+    expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Solid diffusivities = -0.1\n")); },
+                 "NNPP/Solid diffusivities", "negative solid diffusivity");
   }
 } // namespace
 
@@ -628,6 +727,7 @@ main(int argc, char **argv)
              {{"k_constants", k_constants},
               {"local_limit", local_limit},
               {"manufactured", manufactured},
+              {"jacobian", jacobian},
               {"mass_conservation", mass_conservation},
               {"rank_invariance", rank_invariance},
               {"bad_input", bad_input}});

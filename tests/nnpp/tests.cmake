@@ -1,6 +1,6 @@
 perideal_add_test_program(nnpp_tests ${CMAKE_CURRENT_LIST_DIR}/nnpp_tests.cc)
 
-foreach(_t k_constants bad_input)
+foreach(_t k_constants bad_input jacobian)
   perideal_add_test(NAME nnpp.${_t} COMMAND $<TARGET_FILE:nnpp_tests> ${_t} LABELS unit)
 endforeach()
 foreach(_t local_limit manufactured)
