@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <sstream>
 
 namespace PeriDEAL
 {
@@ -616,12 +617,13 @@ namespace PeriDEAL
             const double norm = residual.l2_norm();
             if (norm <= prm.newton_tolerance * ref || norm == 0.)
               break;
+            std::ostringstream rel;
+            rel << std::scientific << norm / ref;
             AssertThrow(m < prm.max_newton_iterations,
                         ExcMessage("NNPP: modified Newton did not converge for species " +
                                    std::to_string(k) + " in 'NNPP/Max Newton iterations' = " +
                                    std::to_string(prm.max_newton_iterations) +
-                                   " iterations (||F|| = " + std::to_string(norm / ref) +
-                                   " relative)."));
+                                   " iterations (||F|| / ||C^n/dt|| = " + rel.str() + ")."));
             SolverControl                 control(10000, prm.linear_tolerance * norm);
             TrilinosWrappers::SolverGMRES gmres(control);
             update = 0.;
