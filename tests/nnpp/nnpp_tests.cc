@@ -189,7 +189,7 @@ namespace
     return NnppOperator<2>(disc, p).k2();
   }
 
-  // Max error of the discrete operator (migration or diffusion term) over
+  // Max relative error of the discrete operator (migration or diffusion term) over
   // the nodes with |x|_inf <= inner of a box large enough for their
   // families to be full.
   template <int dim>
@@ -228,7 +228,7 @@ namespace
     C.update_ghost_values();
     phi.update_ghost_values();
     op.apply_species(0, C, phi, rate, nullptr, terms);
-    double err = 0.;
+    double err = 0., scale = 0.;
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       {
         bool is_inner = true;
@@ -239,9 +239,11 @@ namespace
         const double exact = terms == NnppOperator<dim>::Terms::migration ?
                                div_c_grad_phi(disc.position[i]) :
                                laplace_c(disc.position[i]);
-        err = std::max(err, std::abs(rate.local_element(i) - exact));
+        err   = std::max(err, std::abs(rate.local_element(i) - exact));
+        scale = std::max(scale, std::abs(exact));
       }
-    return Utilities::MPI::max(err, MPI_COMM_WORLD);
+    // Relative to the largest exact value in the region.
+    return Utilities::MPI::max(err, MPI_COMM_WORLD) / Utilities::MPI::max(scale, MPI_COMM_WORLD);
   }
 
   void
@@ -261,7 +263,7 @@ namespace
             // K2 = K1/2 at equal exponents (the value (2.75) implies).
             check_close(k2, 0.5 * nnpp_k1(2, InfluenceFunction::constant, q, delta), 1e-12,
                         "K2 = K1/2, q = " + std::to_string(q));
-            err.push_back(std::abs(continuous_migration_2d(k2, q, delta, x0) - exact));
+            err.push_back(std::abs(continuous_migration_2d(k2, q, delta, x0) - exact) / std::abs(exact));
             if (delta == 0.05)
               {
                 const double thesis =
@@ -276,7 +278,7 @@ namespace
           }
         const double r1 = std::log2(err[0] / err[1]), r2 = std::log2(err[1] / err[2]);
         if (root())
-          std::cout << "  continuous, q = " << q << ": errors " << sci(err[0]) << " "
+          std::cout << "  continuous, q = " << q << ": relative errors " << sci(err[0]) << " "
                     << sci(err[1]) << " " << sci(err[2]) << " rates " << r1 << " " << r2
                     << std::endl;
         // Taylor: error = c delta^2 + O(delta^4); 1.9 leaves room for the O(delta^4) term.
@@ -301,7 +303,7 @@ namespace
           }
         auto rate = [](const std::vector<double> &e) { return std::log2(e[1] / e[2]); };
         if (root())
-          std::cout << "  discrete m = 3, q = " << q << ": 2D migration " << sci(em[0]) << " "
+          std::cout << "  discrete m = 3, q = " << q << ", relative errors: 2D migration " << sci(em[0]) << " "
                     << sci(em[1]) << " " << sci(em[2]) << " (rate " << rate(em)
                     << "), 2D diffusion rate " << rate(ed) << ", 1D migration " << sci(em1[2])
                     << " (rate " << rate(em1) << "), 3D migration " << sci(em3[2]) << " (rate " << rate(em3)
@@ -391,6 +393,7 @@ namespace
       {
         jacobian_case<1>(b);
         jacobian_case<2>(b);
+        jacobian_case<3>(b);
       }
   }
 
