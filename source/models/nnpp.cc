@@ -69,6 +69,13 @@ namespace PeriDEAL
     prm.declare_entry("Species boundary", "closed", Patterns::Selection("closed|dirichlet"),
                       "closed: no species flux through bonds to the volume-constraint "
                       "layer. dirichlet: the layer holds prescribed concentrations.");
+    prm.declare_entry("Phase species", "-1", Patterns::Integer(-1),
+                      "Index (from 0) of the species whose concentration decides the "
+                      "phase by (2.79) (solid turns liquid once it falls below "
+                      "'Saturation concentration', never back); -1: the phase field "
+                      "is not updated.");
+    prm.declare_entry("Saturation concentration", "0.85", Patterns::Double(),
+                      "C_sat of (2.79).");
     prm.declare_entry("Time step", "1e-3", Patterns::Double(), "dt > 0.");
     prm.declare_entry("Max Newton iterations", "30", Patterns::Integer(1),
                       "Modified Newton (3.16)-(3.17) iterations per species and step.");
@@ -99,6 +106,8 @@ namespace PeriDEAL
     calibration             = prm.get("Calibration");
     k2_convention           = prm.get("K2 convention");
     species_boundary        = prm.get("Species boundary");
+    phase_species           = prm.get_integer("Phase species");
+    saturation              = prm.get_double("Saturation concentration");
     time_step               = prm.get_double("Time step");
     max_newton_iterations   = prm.get_integer("Max Newton iterations");
     newton_tolerance        = prm.get_double("Newton tolerance");
@@ -149,6 +158,9 @@ namespace PeriDEAL
     check_parameter(faraday > 0., "NNPP/Faraday constant", faraday, "a positive number");
     check_parameter(gas_constant > 0., "NNPP/Gas constant", gas_constant, "a positive number");
     check_parameter(temperature > 0., "NNPP/Temperature", temperature, "a positive number");
+    check_parameter(phase_species < int(n), "NNPP/Phase species", phase_species,
+                    "-1 or a species index below the number of valences (" + std::to_string(n) +
+                      ")");
     check_parameter(time_step > 0., "NNPP/Time step", time_step, "a positive time step");
     check_parameter(newton_tolerance > 0., "NNPP/Newton tolerance", newton_tolerance,
                     "a positive number");
@@ -637,6 +649,26 @@ namespace PeriDEAL
         last_newton_iterations += m;
       }
     current_time = t_new;
+
+    last_phase_changes = 0;
+    if (prm.phase_species >= 0)
+      {
+        // The one-way rule (2.79) of the corrosion model (update_corrosion_phase).
+        unsigned int changed = 0;
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          if (disc.region[i] == Discretization<dim>::interior && phase.local_element(i) > 0.5 &&
+              C[prm.phase_species].local_element(i) < prm.saturation)
+            {
+              phase.local_element(i) = 0.;
+              ++changed;
+            }
+        last_phase_changes = Utilities::MPI::sum(changed, comm);
+        if (last_phase_changes > 0)
+          {
+            phase.update_ghost_values();
+            poisson_valid = false; // sigma follows the bond types
+          }
+      }
   }
 
   template class NnppOperator<1>;

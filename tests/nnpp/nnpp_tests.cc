@@ -654,6 +654,79 @@ end
     check(s.phi.linfty_norm() > 1e-3, "non-trivial potential");
   }
 
+  // Corrosion in the NNPP system: the metal species decides the phase by
+  // (2.79), bonds follow (2.78), sigma too (Poisson matrix rebuilt after a
+  // phase change). 1D: solid metal (C = 1) on (0, 1), electrolyte on (1, 2).
+  void
+  phase_change()
+  {
+    LatticeParameters lp;
+    lp.dx              = 0.02;
+    lp.delta           = 0.06;
+    lp.layer_thickness = lp.delta + 0.5 * lp.dx;
+    BoxDomain<1>      box(Point<1>(0.), Point<1>(2.));
+    Discretization<1> disc(MPI_COMM_WORLD);
+    disc.setup(box, lp);
+    const auto p = parameters_from_text<NnppParameters>(R"(
+subsection NNPP
+  set Valences = 2, -1
+  set Diffusivities = 1, 0.5
+  set Interface diffusivities = 0.1, 0.05
+  set Solid diffusivities = 0, 0
+  set Conductivities = 1, 0.5, 0.2
+  set Faraday constant = 1
+  set Gas constant = 1
+  set Temperature = 1
+  set Phase species = 0
+  set Saturation concentration = 0.85
+  set Time step = 0.005
+  set Newton tolerance = 1e-14
+end
+)");
+    NnppSources<1> src;
+    src.boundary_potential = [](const Point<1> &x, double) { return x[0] < 1. ? -0.3 : 0.; };
+    NnppSolver<1> s(disc, p, src);
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      s.phase.local_element(i) = disc.position[i][0] < 1. - 1e-12 ? 1. : 0.;
+    s.phase.update_ghost_values();
+    s.set_concentration(0, [](const Point<1> &x) { return x[0] < 1. - 1e-12 ? 1. : 0.; });
+    s.set_concentration(1, [](const Point<1> &) { return 0.5; });
+    auto n_solid = [&] {
+      unsigned int n = 0;
+      for (unsigned int i = 0; i < disc.n_owned(); ++i)
+        n += disc.region[i] == Discretization<1>::interior && s.phase.local_element(i) > 0.5;
+      return Utilities::MPI::sum(n, MPI_COMM_WORLD);
+    };
+    const unsigned int solid0 = n_solid();
+    const double       m0 = s.mass(0), m1 = s.mass(1);
+    double             dev = 0.;
+    bool               monotone = true, reverted = false;
+    unsigned int       flips = 0, previous = solid0;
+    std::vector<double> old_phase(disc.n_owned());
+    for (unsigned int n = 0; n < 200; ++n)
+      {
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          old_phase[i] = s.phase.local_element(i);
+        s.step();
+        for (unsigned int i = 0; i < disc.n_owned(); ++i)
+          reverted = reverted || (old_phase[i] < 0.5 && s.phase.local_element(i) > 0.5);
+        flips += s.last_phase_changes;
+        const unsigned int now = n_solid();
+        monotone = monotone && now <= previous && previous - now == s.last_phase_changes;
+        previous = now;
+        dev = std::max({dev, std::abs(s.mass(0) - m0) / m0, std::abs(s.mass(1) - m1) / m1});
+      }
+    reverted = Utilities::MPI::logical_or(reverted, MPI_COMM_WORLD);
+    if (root())
+      std::cout << "  solid nodes " << solid0 << " -> " << previous << " (" << flips
+                << " phase changes in 200 steps), max relative mass change " << sci(dev)
+                << std::endl;
+    check(flips >= 3 && previous == solid0 - flips, "the metal dissolves: solid nodes turn liquid");
+    check(monotone && !reverted, "one-way rule (2.79): no node turns back to solid");
+    // Phase changes only alter bond coefficients, never C: mass to the Newton tolerance.
+    check(dev < 1e-12, "mass of each species conserved to 1e-12 through phase changes");
+  }
+
   // The same 2D run (manufactured problem, 4 steps) on MPI_COMM_WORLD and on
   // one rank (MPI_COMM_SELF), compared node by node via the lattice ids.
   void
@@ -734,6 +807,8 @@ end
                  "NNPP/Conductivities", "two conductivities");
     expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Conductivities = 1, 0.5, 0\n")); },
                  "NNPP/Conductivities", "zero solid conductivity");
+    expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Phase species = 1\n")); },
+                 "NNPP/Phase species", "phase species out of range");
     expect_error([&] { parameters_from_text<NnppParameters>(with(" set Valences = 1\n set Diffusivities = 1\n set Solid diffusivities = -0.1\n")); },
                  "NNPP/Solid diffusivities", "negative solid diffusivity");
   }
@@ -747,6 +822,7 @@ main(int argc, char **argv)
               {"local_limit", local_limit},
               {"manufactured", manufactured},
               {"jacobian", jacobian},
+              {"phase_change", phase_change},
               {"mass_conservation", mass_conservation},
               {"rank_invariance", rank_invariance},
               {"bad_input", bad_input}});

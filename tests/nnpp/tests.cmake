@@ -13,3 +13,7 @@ perideal_add_test(NAME nnpp.mass_conservation.np2 NPROCS 2
   COMMAND $<TARGET_FILE:nnpp_tests> mass_conservation LABELS "unit;mpi")
 perideal_add_test(NAME nnpp.rank_invariance.np2 NPROCS 2
   COMMAND $<TARGET_FILE:nnpp_tests> rank_invariance LABELS mpi)
+perideal_add_test(NAME nnpp.phase_change
+  COMMAND $<TARGET_FILE:nnpp_tests> phase_change LABELS unit)
+perideal_add_test(NAME nnpp.phase_change.np2 NPROCS 2
+  COMMAND $<TARGET_FILE:nnpp_tests> phase_change LABELS "unit;mpi")

@@ -65,6 +65,16 @@ namespace PeriDEAL
      * default 0), which makes the Poisson matrix non-singular.
      */
     std::string species_boundary = "closed";
+    /**
+     * Corrosion phase rule (2.79) coupled to (2.78): index of the species
+     * whose concentration decides the phase (the metal), or -1 (default:
+     * the phase field stays as the user set it). After each step a solid
+     * node whose C_phase_species fell below @p saturation becomes liquid
+     * (one way), and the Poisson matrix is reassembled.
+     */
+    int phase_species = -1;
+    /** C_sat of (2.79). */
+    double saturation = 0.85;
     /** Time step (> 0). */
     double time_step = 1e-3;
     /** Modified Newton: at most this many iterations per species and step. */
@@ -330,6 +340,9 @@ namespace PeriDEAL
     /** Total mass sum_i V_i C_{k,i} over the interior nodes (collective). */
     double
     mass(const unsigned int k) const;
+
+    /** Number of nodes that turned liquid in the last step (all ranks). */
+    unsigned int last_phase_changes = 0;
 
     /** Newton iterations of the last step (summed over species), CG/GMRES iterations. */
     unsigned int last_newton_iterations = 0, last_linear_iterations = 0;
