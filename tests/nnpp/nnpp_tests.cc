@@ -703,7 +703,7 @@ end
     bool               monotone = true, reverted = false;
     unsigned int       flips = 0, previous = solid0;
     std::vector<double> old_phase(disc.n_owned());
-    for (unsigned int n = 0; n < 200; ++n)
+    for (unsigned int n = 0; n < 100; ++n)
       {
         for (unsigned int i = 0; i < disc.n_owned(); ++i)
           old_phase[i] = s.phase.local_element(i);
@@ -719,7 +719,7 @@ end
     reverted = Utilities::MPI::logical_or(reverted, MPI_COMM_WORLD);
     if (root())
       std::cout << "  solid nodes " << solid0 << " -> " << previous << " (" << flips
-                << " phase changes in 200 steps), max relative mass change " << sci(dev)
+                << " phase changes in 100 steps), max relative mass change " << sci(dev)
                 << std::endl;
     check(flips >= 3 && previous == solid0 - flips, "the metal dissolves: solid nodes turn liquid");
     check(monotone && !reverted, "one-way rule (2.79): no node turns back to solid");
