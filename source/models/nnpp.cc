@@ -61,7 +61,7 @@ namespace PeriDEAL
                       "from the lattice sum of the interior stencil (exact for "
                       "quadratic fields; converges at fixed m).");
     prm.declare_entry("K2 convention", "local limit",
-                      Patterns::Selection("local limit|thesis \\(2.77\\)"),
+                      Patterns::Selection("local limit|thesis (2.77)"),
                       "local limit: K2 = 1/M (= K1/2 at q1 = q2), verified "
                       "numerically (doc/design.md, Session 19). thesis (2.77): "
                       "K2 = K1 as printed, which converges to twice the local "
@@ -541,10 +541,15 @@ namespace PeriDEAL
     TrilinosWrappers::MPI::Vector rhs(owned, comm), x(owned, comm);
     std::copy(b.begin(), b.begin() + disc.n_owned(), rhs.begin());
     std::copy(phi.begin(), phi.begin() + disc.n_owned(), x.begin());
-    SolverControl               control(10000, prm.linear_tolerance * rhs.l2_norm());
-    TrilinosWrappers::SolverCG  cg(control);
-    cg.solve(poisson_matrix, x, rhs, poisson_amg);
-    last_linear_iterations += control.last_step();
+    if (rhs.l2_norm() == 0.)
+      x = 0.; // no charge, phi = 0 on the layer: the solution is 0
+    else
+      {
+        SolverControl              control(10000, prm.linear_tolerance * rhs.l2_norm());
+        TrilinosWrappers::SolverCG cg(control);
+        cg.solve(poisson_matrix, x, rhs, poisson_amg);
+        last_linear_iterations += control.last_step();
+      }
     std::copy(x.begin(), x.begin() + disc.n_owned(), phi.begin());
     phi.update_ghost_values();
   }

@@ -103,6 +103,14 @@ namespace
                         k1_by_quadrature(dim, InfluenceFunction::linear, q, delta), 1e-10,
                         "nnpp_k1 omega_1 vs quadrature, " + what);
           }
+    // The "reduction check" below (2.77): omega = 1, q = -1/2 (kernel
+    // 1/|xi|^2 in 3D) with K1 = K2 = 1/V_H is said to give back (2.59).
+    // The local-limit calibration gives K1 = 4.5/(pi delta^3) = 6/V_H and
+    // K2 = 3/V_H instead (V_H = 4 pi delta^3/3): (2.59) with kappa = D/V_H
+    // has 1/6 of the diffusivity D.
+    const double vh = 4. * numbers::PI / 3. * std::pow(0.7, 3);
+    check_close(nnpp_k1(3, InfluenceFunction::constant, -0.5, 0.7) * vh, 6., 1e-12,
+                "3D q = -1/2: K1 V_H = 6 (not 1)");
     // (2.72) spelled out: 3D q = 0 -> 3 / (pi delta^2).
     check_close(nnpp_k1_closed_form(3, 0., 2.), 3. / (numbers::PI * 4.), 1e-15,
                 "(2.72) at q = 0, delta = 2");
@@ -782,6 +790,12 @@ end
   {
     auto p = parameters_from_text<NnppParameters>(good);
     check(p.n_species() == 2 && p.diffusivity[1][2] == 0.5, "good input parses (2 species)");
+    const auto t = parameters_from_text<NnppParameters>(
+      "subsection NNPP\n set Valences = 1\n set Diffusivities = 1\n set K2 convention = thesis (2.77)\n"
+      " set Calibration = discrete\n set Species boundary = dirichlet\nend\n");
+    check(t.k2_convention == "thesis (2.77)" && t.calibration == "discrete" &&
+            t.species_boundary == "dirichlet",
+          "selections parse from text");
     auto with = [](const std::string &entries) {
       return "subsection NNPP\n" + entries + "end\n";
     };
