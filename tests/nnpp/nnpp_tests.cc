@@ -607,15 +607,22 @@ namespace
   // Closed box, two species, phases (solid for x > 0.2) with the bond rule
   // (2.78) and phase-dependent sigma, no reactions: each species' mass must
   // stay constant up to the Newton/GMRES tolerance.
+  template <int dim>
   void
-  mass_conservation()
+  mass_conservation_case(const double dx, const unsigned int n_steps)
   {
     LatticeParameters lp;
-    lp.dx              = 0.05;
-    lp.delta           = 0.15;
-    lp.layer_thickness = 0.15; // Dirichlet layer of phi only (species closed)
-    BoxDomain<2>      box(Point<2>(-1., -0.5), Point<2>(1., 0.5));
-    Discretization<2> disc(MPI_COMM_WORLD);
+    lp.dx              = dx;
+    lp.delta           = 3. * dx;
+    lp.layer_thickness = lp.delta + 0.5 * dx; // Dirichlet layer of phi only (species closed)
+    Point<dim> lo, hi;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lo[d] = d == 0 ? -1. : -0.5;
+        hi[d] = -lo[d];
+      }
+    BoxDomain<dim>      box(lo, hi);
+    Discretization<dim> disc(MPI_COMM_WORLD);
     disc.setup(box, lp);
     // Read through the ParameterHandler path ("NNPP" subsection).
     const auto p = parameters_from_text<NnppParameters>(R"(
@@ -637,29 +644,40 @@ subsection NNPP
 end
 )");
     // Newton tolerance 1e-14: the mass defect is ~ dt sum_i V_i F_i.
-    NnppSources<2> src;
-    src.boundary_potential = [](const Point<2> &x, double) { return 0.5 * x[0]; };
-    NnppSolver<2> s(disc, p, src);
+    NnppSources<dim> src;
+    src.boundary_potential = [](const Point<dim> &x, double) { return 0.5 * x[0]; };
+    NnppSolver<dim> s(disc, p, src);
     for (unsigned int i = 0; i < disc.n_owned(); ++i)
       s.phase.local_element(i) = disc.position[i][0] > 0.2 ? 1. : 0.;
     s.phase.update_ghost_values();
     s.phase_changed();
-    s.set_concentration(0, [](const Point<2> &x) { return std::exp(-10. * x.norm_square()); });
-    s.set_concentration(1, [](const Point<2> &x) { return 1. + 0.5 * std::sin(3. * x[0]) * std::cos(2. * x[1]); });
-    const double m0 = s.mass(0), m1 = s.mass(1);
-    double       dev = 0.;
-    for (unsigned int n = 0; n < 20; ++n)
+    s.set_concentration(0, [](const Point<dim> &x) { return std::exp(-10. * x.norm_square()); });
+    s.set_concentration(1, [](const Point<dim> &x) { return 1. + 0.5 * std::sin(3. * x[0]) * std::cos(2. * x[1]); });
+    const double           m0 = s.mass(0), m1 = s.mass(1);
+    const PeriDEAL::Vector c0 = s.C[0];
+    double                 dev = 0.;
+    for (unsigned int n = 0; n < n_steps; ++n)
       {
         s.step();
         dev = std::max({dev, std::abs(s.mass(0) - m0) / m0, std::abs(s.mass(1) - m1) / m1});
       }
     if (root())
-      std::cout << "  20 steps, max relative mass change " << sci(dev) << ", Newton iterations "
+ std::cout << "  " << dim << "D, " << n_steps << " steps, max relative mass change " << sci(dev) << ", Newton iterations "
                 << s.last_newton_iterations << std::endl;
     // Round-off of the sums plus the Newton tolerance (1e-14) scaled by sqrt(N).
     check(dev < 1e-12, "mass of each species conserved to 1e-12");
     // Something happened: the potential is not trivial and species 0 spread.
     check(s.phi.linfty_norm() > 1e-3, "non-trivial potential");
+    PeriDEAL::Vector change = s.C[0];
+    change -= c0;
+    check(change.linfty_norm() > 1e-2, "species 0 evolved (max change " + sci(change.linfty_norm()) + ")");
+  }
+
+  void
+  mass_conservation()
+  {
+    mass_conservation_case<2>(0.05, 20);
+    mass_conservation_case<3>(0.1, 5);
   }
 
   // Corrosion in the NNPP system: the metal species decides the phase by
