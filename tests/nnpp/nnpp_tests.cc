@@ -600,8 +600,8 @@ namespace
   void
   manufactured()
   {
-    manufactured_case<1>({0.1, 0.05, 0.025}, 0.04);
-    manufactured_case<2>({0.2, 0.1, 0.05}, 0.04);
+    manufactured_case<1>({0.1, 0.05, 0.025}, 0.02);
+    manufactured_case<2>({0.2, 0.1, 0.05}, 0.02);
   }
 
   // Closed box, two species, phases (solid for x > 0.2) with the bond rule
