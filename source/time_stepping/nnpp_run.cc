@@ -137,7 +137,11 @@ namespace PeriDEAL
 
   template <int dim>
   std::vector<NnppDiagnostics>
-  run_nnpp(const NnppRunParameters<dim> &prm, const MPI_Comm comm, const bool verbose)
+  run_nnpp(const NnppRunParameters<dim> &prm,
+           const MPI_Comm                comm,
+           const bool                    verbose,
+           const std::function<void(const Discretization<dim> &, const NnppSolver<dim> &)>
+             &on_finish)
   {
     const bool         root = Utilities::MPI::this_mpi_process(comm) == 0;
     const unsigned int n    = prm.model.n_species();
@@ -261,6 +265,8 @@ namespace PeriDEAL
         std::cout << ", solid volume = " << d.solid_volume << ", max |phi| = " << d.max_abs_phi
                   << " (" << disc.n_global() << " nodes, " << n_steps << " steps)" << std::endl;
       }
+    if (on_finish)
+      on_finish(disc, solver);
     return history;
   }
 
@@ -268,9 +274,12 @@ namespace PeriDEAL
   template struct NnppRunParameters<2>;
   template struct NnppRunParameters<3>;
   template std::vector<NnppDiagnostics>
-  run_nnpp(const NnppRunParameters<1> &, const MPI_Comm, const bool);
+  run_nnpp(const NnppRunParameters<1> &, const MPI_Comm, const bool,
+           const std::function<void(const Discretization<1> &, const NnppSolver<1> &)> &);
   template std::vector<NnppDiagnostics>
-  run_nnpp(const NnppRunParameters<2> &, const MPI_Comm, const bool);
+  run_nnpp(const NnppRunParameters<2> &, const MPI_Comm, const bool,
+           const std::function<void(const Discretization<2> &, const NnppSolver<2> &)> &);
   template std::vector<NnppDiagnostics>
-  run_nnpp(const NnppRunParameters<3> &, const MPI_Comm, const bool);
+  run_nnpp(const NnppRunParameters<3> &, const MPI_Comm, const bool,
+           const std::function<void(const Discretization<3> &, const NnppSolver<3> &)> &);
 } // namespace PeriDEAL

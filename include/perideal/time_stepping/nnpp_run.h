@@ -7,6 +7,7 @@
 #include <perideal/discretization/domain.h>
 #include <perideal/models/nnpp.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,11 +68,16 @@ namespace PeriDEAL
    * and the CSV time series time_series.csv (time, amount_k, solid volume,
    * max |phi|) in the output directory, unless it is empty. phi in the
    * output is the potential of the concentrations at the output time.
-   * Returns the rows of the time series (all ranks). Collective.
+   * Returns the rows of the time series (all ranks). @p on_finish, if set,
+   * sees the final state (tutorials and tests compare fields). Collective.
    */
   template <int dim>
   std::vector<NnppDiagnostics>
-  run_nnpp(const NnppRunParameters<dim> &parameters, const MPI_Comm comm, const bool verbose = true);
+  run_nnpp(const NnppRunParameters<dim> &parameters,
+           const MPI_Comm                comm,
+           const bool                    verbose   = true,
+           const std::function<void(const Discretization<dim> &, const NnppSolver<dim> &)>
+             &on_finish = {});
 } // namespace PeriDEAL
 
 #endif
