@@ -217,6 +217,15 @@ main(int argc, char **argv)
         return m;
       };
       const double x_far = 0.75;
+      // Local charge imbalance |C_A - 2 C_M| = |sum z_k C_k| / 1 away from the grounded ends.
+      auto imbalance = [&p](const Profile &pr) {
+        double m = 0.;
+        for (const auto &r : pr)
+          if (r[0] > 0.1 * p.domain->bounding_box().get_boundary_points().second[0] &&
+              r[0] < 0.9 * p.domain->bounding_box().get_boundary_points().second[0])
+            m = std::max(m, std::abs(r[2] - 2. * r[1]));
+        return m;
+      };
 
       if (root)
         {
@@ -231,6 +240,8 @@ main(int argc, char **argv)
                     << "  M beyond x = " << x_far << " at end " << std::setw(10)
                     << dx * far_metal(migration_profile, x_far) << "   "
                     << dx * far_metal(diffusion_profile, x_far) << "\n"
+                    << "  max |C_A - 2 C_M| inner 80 % " << std::setw(8) << imbalance(migration_profile)
+                    << "   " << imbalance(diffusion_profile) << "\n"
                     << std::scientific << std::setprecision(2)
                     << "  max rel. mass change M " << std::setw(14) << mass_change(migration, 0)
                     << "   " << mass_change(diffusion, 0) << "\n"
@@ -290,6 +301,10 @@ main(int argc, char **argv)
       check(max_phi_migration > 1e-3, "with z = 2, -1 a potential builds up");
       check(max_solid_gap >= node_volume * (1. - 1e-12),
             "electromigration changes the dissolution (solid volumes differ by a node or more)");
+      // The Poisson coupling drives towards electroneutrality (C_A = 2 C_M):
+      // the imbalance must be clearly smaller than without charge.
+      check(imbalance(migration_profile) < 0.5 * imbalance(diffusion_profile),
+            "with migration the ions stay closer to electroneutral (|C_A - 2 C_M| halved or better)");
       return check.failures == 0 ? 0 : 1;
     }
   catch (std::exception &e)
