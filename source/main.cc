@@ -176,6 +176,10 @@ namespace
       }
     if (prm.get("Problem") == "nnpp")
       {
+        // NNPP runs write no checkpoints yet: refuse rather than ignore.
+        if (resume || stop_after != std::numeric_limits<unsigned int>::max())
+          throw ParameterError("command line", resume ? "--resume" : "--stop-after-steps",
+                               "no restart options for Problem = nnpp (no checkpoints yet)");
         run_nnpp_problem<dim>(prm);
         return;
       }

@@ -49,3 +49,6 @@ perideal_add_test(NAME tutorial.step-14 COMMAND $<TARGET_FILE:step-14> ${CMAKE_S
   LABELS "tutorial;unit")
 perideal_add_test(NAME tutorial.step-14.np2 NPROCS 2 COMMAND $<TARGET_FILE:step-14> ${CMAKE_SOURCE_DIR}/tutorial/step-14/step-14.prm
   LABELS "tutorial;mpi")
+perideal_add_test(NAME driver.nnpp.no_resume
+  COMMAND ${_fail} "--resume.*no restart options for Problem = nnpp"
+          ${_perideal} --resume ${CMAKE_CURRENT_LIST_DIR}/driver_2d.prm LABELS unit)
