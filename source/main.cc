@@ -15,6 +15,7 @@
 #include <perideal/io/plot.h>
 #include <perideal/time_stepping/diffusion_solver.h>
 #include <perideal/time_stepping/mechanics_solver.h>
+#include <perideal/time_stepping/nnpp_run.h>
 #include <perideal/time_stepping/static_mechanics.h>
 
 #include <cstdlib>
@@ -49,15 +50,17 @@ namespace
   {
     prm.declare_entry("Dimension", "2", Patterns::Integer(1, 3),
                       "Spatial dimension of the run (1, 2 or 3).");
-    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics|static mechanics"),
+    prm.declare_entry("Problem", "diffusion", Patterns::Selection("diffusion|mechanics|static mechanics|nnpp"),
                       "diffusion: PD diffusion and bi-material corrosion (Model/Type); "
                       "mechanics: dynamic bond-based PD or LPS with brittle fracture "
                       "(Mechanics/Model, Model/Bond-based or Model/LPS, Mechanics); static mechanics: static equilibrium "
-                      "of linearized bond-based PD or LPS (Static mechanics).");
+                      "of linearized bond-based PD or LPS (Static mechanics); nnpp: the nonlocal "
+                      "Nernst-Planck-Poisson system with corrosion (NNPP).");
     // The entries do not depend on the dimension; declare them once.
     DiffusionRunParameters<2>::declare_parameters(prm);
     MechanicsRunParameters<2>::declare_parameters(prm);
     StaticMechanicsParameters<2>::declare_parameters(prm);
+    NnppRunParameters<2>::declare_parameters(prm);
   }
 
   // A PNG of the time series.
@@ -135,12 +138,49 @@ namespace
 
   template <int dim>
   void
+  run_nnpp_problem(ParameterHandler &prm)
+  {
+    NnppRunParameters<dim> parameters;
+    parameters.parse_parameters(prm);
+    const std::string dir = parameters.output_directory;
+    if (!dir.empty())
+      write_used_parameters(prm, dir);
+    const auto history = run_nnpp<dim>(parameters, MPI_COMM_WORLD);
+    if (!dir.empty() && Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+      {
+        // Columns: time, amount_0 ... amount_{N-1}, solid_volume, max_abs_phi.
+        const unsigned int n   = parameters.model.n_species();
+        const std::string  csv = "'" + dir + "/time_series.csv'";
+        std::string        gp  = gnuplot_png_preamble(dir + "/time_series.png") +
+                         "set datafile separator ','\nset key autotitle columnhead\n"
+                         "set xlabel 'time'\nset ylabel 'amount, solid volume'\n"
+                         "set y2label 'max |phi|'\nset y2tics\nplot ";
+        for (unsigned int k = 0; k < n; ++k)
+          gp += (k == 0 ? csv : std::string("''")) + " using 1:" + std::to_string(k + 2) +
+                " with lines lw 2, ";
+        gp += "'' using 1:" + std::to_string(n + 2) + " with lines lw 2, '' using 1:" +
+              std::to_string(n + 3) + " axes x1y2 with lines lw 2\n";
+        run_gnuplot(dir + "/plot.gp", gp, dir + "/time_series.png");
+      }
+  }
+
+  template <int dim>
+  void
   run(ParameterHandler &prm, const bool resume, const unsigned int stop_after)
   {
     if (prm.get("Problem") == "static mechanics")
       {
         write_used_parameters(prm, prm.get({"Output"}, "Directory"));
         run_static_mechanics<dim>(prm, MPI_COMM_WORLD);
+        return;
+      }
+    if (prm.get("Problem") == "nnpp")
+      {
+        // NNPP runs write no checkpoints yet: refuse rather than ignore.
+        if (resume || stop_after != std::numeric_limits<unsigned int>::max())
+          throw ParameterError("command line", resume ? "--resume" : "--stop-after-steps",
+                               "no restart options for Problem = nnpp (no checkpoints yet)");
+        run_nnpp_problem<dim>(prm);
         return;
       }
     if (prm.get("Problem") == "mechanics")
