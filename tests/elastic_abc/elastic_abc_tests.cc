@@ -651,7 +651,7 @@ namespace
     // the default abc_parameters() has 0.91x, 2.9x, 1.44x on R = 32 and
     // 0.81x, 1.09x, 0.56x off centre). Asserted: the 10x at T in
     // energy and field (margins >= 3.7x) and over the run (margin >= 1.9x).
-    for (const Case c : {Case{16., 48., 2.5, 1., 3., 0.5, 48}, Case{32., 96., 5., 1., 3., 0.5, 48},
+    for (const Case &c : {Case{16., 48., 2.5, 1., 3., 0.5, 48}, Case{32., 96., 5., 1., 3., 0.5, 48},
                          Case{32., 96., 5., 1., 3., 0.5, 48, 0.02, 16.}})
       {
         const auto r = first_order_case(c, ElasticAbcLayers::curved_tikhonov(c.dx, c.R));
