@@ -1,9 +1,11 @@
 #include <perideal/abc/ebf_cloud.h>
+#include <perideal/base/exceptions.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
+#include <string>
 
 namespace PeriDEAL
 {
@@ -116,6 +118,38 @@ namespace PeriDEAL
       return cloud;
     }
 
+    template <int dim>
+    std::vector<std::pair<unsigned int, Tensor<1, dim>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, dim>>> &cone,
+                         const unsigned int                                          n,
+                         const std::vector<types::global_dof_index>                 &ids,
+                         const double                                                dx,
+                         const double                                                search_radius)
+    {
+      using Entry = std::pair<unsigned int, Tensor<1, dim>>;
+      if (cone.size() < n + 1)
+        throw ParameterError("Absorbing boundary/Cloud size", std::to_string(n),
+                             "1 .. the " + std::to_string(cone.size() - 1) +
+                               " cone points within the search radius (Cloud radius) " +
+                               std::to_string(search_radius) + " of the boundary DoF with global id " +
+                               std::to_string(ids[cone[0].first]) + " (reduce the cloud size or enlarge the cloud radius)");
+      // Distance first, then the global id: a rank-independent order.
+      std::vector<Entry> rest(cone.begin() + 1, cone.end());
+      std::sort(rest.begin(), rest.end(), [&ids](const Entry &p, const Entry &q) {
+        const double a = p.second.norm(), b = q.second.norm();
+        return a != b ? a < b : ids[p.first] < ids[q.first];
+      });
+      std::vector<Entry> out(1, cone[0]);
+      if (n == 0)
+        return out;
+      const double dn = rest[n - 1].second.norm();
+      for (const auto &e : rest)
+        if (e.second.norm() <= dn + 1e-9 * dx)
+          out.push_back(e);
+      std::sort(out.begin() + 1, out.end(), [&ids](const Entry &p, const Entry &q) { return ids[p.first] < ids[q.first]; });
+      return out;
+    }
+
     PseudoInverseFit
     pseudo_inverse_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance)
     {
@@ -137,6 +171,15 @@ namespace PeriDEAL
       return f;
     }
 
+    template std::vector<std::pair<unsigned int, Tensor<1, 1>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 1>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double);
+    template std::vector<std::pair<unsigned int, Tensor<1, 2>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 2>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double);
+    template std::vector<std::pair<unsigned int, Tensor<1, 3>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 3>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double);
     template class EbfCloudBuilder<1>;
     template class EbfCloudBuilder<2>;
   } // namespace Abc

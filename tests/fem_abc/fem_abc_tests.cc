@@ -943,8 +943,8 @@ namespace
   // (e13_default) with the EBF keys of with_wave_settings, plus L, T, dt,
   // newmark=1, rho=1 (one-step spectral radius on (-3, 3)^2, h = 0.5) or
   // rhoonly=1, where=n (the n largest field errors at t_end and the max
-  // error per ring along the boundary) and lref (half width of the extended
-  // reference).
+  // error per ring along the boundary), lref (half width of the extended
+  // reference) and csize (Cloud size, session 19).
   void
   e13_scan()
   {
@@ -957,6 +957,7 @@ namespace
         const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv.at(k)) : def; };
         E13        c   = e13_default();
         c.abc          = with_wave_settings(c.abc, kv);
+        c.abc.cloud_size = static_cast<unsigned int>(num("csize", c.abc.cloud_size));
         c.L            = num("L", c.L);
         c.t_end        = num("T", c.t_end);
         c.dt           = num("dt", c.dt);
