@@ -453,6 +453,23 @@ namespace
           "consistent mass + Verlet rejected naming FEM/Lumped mass");
     check(rejected(scheme("leapfrog", true), Fem::WaveBoundary::dirichlet, "FEM/Scheme"),
           "unknown scheme rejected naming FEM/Scheme");
+    // Cloud size (session 19): at most 50, and the cone within the search
+    // radius (here the default 2 n h = 20, i.e. the whole 5 x 5 mesh) must
+    // hold n points; 4 (the 2 h cloud of the square's edges) is accepted.
+    check(rejected([](E13 &c) { c.abc.cloud_size = 51; }, Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 51 rejected naming Absorbing boundary/Cloud size");
+    check(rejected([](E13 &c) { c.abc.cloud_size = 20; }, Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 20 (more than the cone holds) rejected naming Absorbing boundary/Cloud size");
+    check(rejected(
+            [](E13 &c) {
+              c.abc.cloud_size   = 6;
+              c.abc.cloud_radius = 1.;
+            },
+            Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 6 with the search radius 2 h (edge cones hold 4 points) rejected naming Absorbing "
+          "boundary/Cloud size");
+    check(!rejected([](E13 &c) { c.abc.cloud_size = 4; }, Fem::WaveBoundary::absorbing, "Cloud size"),
+          "Cloud size 4 accepted");
     // Curved modes need the centre x_i - rho n outside the cloud (the
     // default cloud radius 2 h = 1).
     check(rejected([](E13 &c) { c.abc.curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing, "Curvature radius"),
