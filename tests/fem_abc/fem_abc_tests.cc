@@ -961,7 +961,7 @@ namespace
   // newmark=1, rho=1 (one-step spectral radius on (-3, 3)^2, h = 0.5) or
   // rhoonly=1, where=n (the n largest field errors at t_end and the max
   // error per ring along the boundary), lref (half width of the extended
-  // reference) and csize (Cloud size, session 19).
+  // reference) and csize (Cloud size, session 19), crule (nearest|normal: Cloud size rule).
   void
   e13_scan()
   {
@@ -975,6 +975,8 @@ namespace
         E13        c   = e13_default();
         c.abc          = with_wave_settings(c.abc, kv);
         c.abc.cloud_size = static_cast<unsigned int>(num("csize", c.abc.cloud_size));
+        if (kv.count("crule"))
+          c.abc.cloud_size_rule = kv.at("crule") == "normal" ? "normal line" : kv.at("crule");
         c.L            = num("L", c.L);
         c.t_end        = num("T", c.t_end);
         c.dt           = num("dt", c.dt);
