@@ -470,6 +470,13 @@ namespace
           "boundary/Cloud size");
     check(!rejected([](E13 &c) { c.abc.cloud_size = 4; }, Fem::WaveBoundary::absorbing, "Cloud size"),
           "Cloud size 4 accepted");
+    check(rejected(
+            [](E13 &c) {
+              c.abc.cloud_size      = 2;
+              c.abc.cloud_size_rule = "farthest";
+            },
+            Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size rule"),
+          "unknown Cloud size rule rejected naming Absorbing boundary/Cloud size rule");
     // Curved modes need the centre x_i - rho n outside the cloud (the
     // default cloud radius 2 h = 1).
     check(rejected([](E13 &c) { c.abc.curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing, "Curvature radius"),
