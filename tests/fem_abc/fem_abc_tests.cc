@@ -4,6 +4,7 @@
 // homogeneous-Dirichlet reference, the one-step spectral radius, and the
 // consistency of the absorbing update.
 
+#include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/function.h>
 #include <deal.II/base/function_lib.h>
 
@@ -470,6 +471,16 @@ namespace
           "boundary/Cloud size");
     check(!rejected([](E13 &c) { c.abc.cloud_size = 4; }, Fem::WaveBoundary::absorbing, "Cloud size"),
           "Cloud size 4 accepted");
+    {
+      // The entries parse into the struct.
+      ParameterHandler prm;
+      Abc::WaveAbcParameters::declare_parameters(prm);
+      prm.set("Cloud size", "2");
+      prm.set("Cloud size rule", "normal line");
+      Abc::WaveAbcParameters p;
+      p.parse_parameters(prm);
+      check(p.cloud_size == 2 && p.cloud_size_rule == "normal line", "Cloud size and Cloud size rule parsed");
+    }
     check(rejected(
             [](E13 &c) {
               c.abc.cloud_size      = 2;
