@@ -1,9 +1,11 @@
 #include <perideal/abc/ebf_cloud.h>
+#include <perideal/base/exceptions.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
+#include <string>
 
 namespace PeriDEAL
 {
@@ -116,6 +118,63 @@ namespace PeriDEAL
       return cloud;
     }
 
+    template <int dim>
+    std::vector<std::pair<unsigned int, Tensor<1, dim>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, dim>>> &cone,
+                         const unsigned int                                          n,
+                         const std::vector<types::global_dof_index>                 &ids,
+                         const double                                                dx,
+                         const double                                                search_radius,
+                         const bool                                                  along_normal)
+    {
+      using Entry = std::pair<unsigned int, Tensor<1, dim>>;
+      if (along_normal)
+        {
+          // The n-th distance among the points near the inward normal line
+          // (lateral offset < depth / 2, 26.6 degrees), then every cone
+          // point within it.
+          std::vector<Entry> line(1, cone[0]);
+          for (unsigned int c = 1; c < cone.size(); ++c)
+            {
+              double lat2 = 0.;
+              for (unsigned int d = 1; d < dim; ++d)
+                lat2 += cone[c].second[d] * cone[c].second[d];
+              if (std::sqrt(lat2) < 0.5 * (-cone[c].second[0]))
+                line.push_back(cone[c]);
+            }
+          const auto   on_line = nearest_cloud_points<dim>(line, n, ids, dx, search_radius, false);
+          double       dn      = 0.;
+          for (const auto &e : on_line)
+            dn = std::max(dn, e.second.norm());
+          std::vector<Entry> out(1, cone[0]);
+          for (unsigned int c = 1; c < cone.size(); ++c)
+            if (cone[c].second.norm() <= dn + 1e-9 * dx)
+              out.push_back(cone[c]);
+          return out;
+        }
+      if (cone.size() < n + 1)
+        throw ParameterError("Absorbing boundary/Cloud size", std::to_string(n),
+                             "1 .. the " + std::to_string(cone.size() - 1) +
+                               " cone points within the search radius (Cloud radius) " +
+                               std::to_string(search_radius) + " of the boundary DoF with global id " +
+                               std::to_string(ids[cone[0].first]) + " (reduce the cloud size or enlarge the cloud radius)");
+      // Distance first, then the global id: a rank-independent order.
+      std::vector<Entry> rest(cone.begin() + 1, cone.end());
+      std::sort(rest.begin(), rest.end(), [&ids](const Entry &p, const Entry &q) {
+        const double a = p.second.norm(), b = q.second.norm();
+        return a != b ? a < b : ids[p.first] < ids[q.first];
+      });
+      std::vector<Entry> out(1, cone[0]);
+      if (n == 0)
+        return out;
+      const double dn = rest[n - 1].second.norm();
+      for (const auto &e : rest)
+        if (e.second.norm() <= dn + 1e-9 * dx)
+          out.push_back(e);
+      std::sort(out.begin() + 1, out.end(), [&ids](const Entry &p, const Entry &q) { return ids[p.first] < ids[q.first]; });
+      return out;
+    }
+
     PseudoInverseFit
     pseudo_inverse_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance)
     {
@@ -137,6 +196,15 @@ namespace PeriDEAL
       return f;
     }
 
+    template std::vector<std::pair<unsigned int, Tensor<1, 1>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 1>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double, bool);
+    template std::vector<std::pair<unsigned int, Tensor<1, 2>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 2>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double, bool);
+    template std::vector<std::pair<unsigned int, Tensor<1, 3>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 3>>> &, unsigned int,
+                         const std::vector<types::global_dof_index> &, double, double, bool);
     template class EbfCloudBuilder<1>;
     template class EbfCloudBuilder<2>;
   } // namespace Abc

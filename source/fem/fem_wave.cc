@@ -105,8 +105,12 @@ namespace PeriDEAL
       h                          = Utilities::MPI::max(h, tria.get_communicator());
       const double           spacing = h / prm.degree;
       Abc::WaveAbcParameters ap      = abc_prm;
+      // With a cloud size n the radius is only the search radius of the
+      // n nearest cone points (and the ghost layer): 2 n spacings hold
+      // them with room on distorted meshes (hyper_ball: the second point
+      // along the normal at up to 2.03 h).
       if (ap.cloud_radius <= 0.)
-        ap.cloud_radius = 2. * spacing * (1. + 1e-9);
+        ap.cloud_radius = (ap.cloud_size > 0 ? 2. * ap.cloud_size : 2.) * spacing * (1. + 1e-9);
       near_field.reinit(dof_handler, absorbing ? ap.cloud_radius : 0.);
       const auto &part = near_field.partitioner;
       near_field.assemble(mass_matrix, stiffness, mass, boundary_mass);

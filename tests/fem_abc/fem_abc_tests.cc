@@ -4,6 +4,7 @@
 // homogeneous-Dirichlet reference, the one-step spectral radius, and the
 // consistency of the absorbing update.
 
+#include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/function.h>
 #include <deal.II/base/function_lib.h>
 
@@ -453,6 +454,40 @@ namespace
           "consistent mass + Verlet rejected naming FEM/Lumped mass");
     check(rejected(scheme("leapfrog", true), Fem::WaveBoundary::dirichlet, "FEM/Scheme"),
           "unknown scheme rejected naming FEM/Scheme");
+    // Cloud size (session 19): at most 50, and the cone within the search
+    // radius (here the default 2 n h = 20, i.e. the whole 5 x 5 mesh) must
+    // hold n points; 4 (the 2 h cloud of the square's edges) is accepted.
+    check(rejected([](E13 &c) { c.abc.cloud_size = 51; }, Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 51 rejected naming Absorbing boundary/Cloud size");
+    check(rejected([](E13 &c) { c.abc.cloud_size = 20; }, Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 20 (more than the cone holds) rejected naming Absorbing boundary/Cloud size");
+    check(rejected(
+            [](E13 &c) {
+              c.abc.cloud_size   = 6;
+              c.abc.cloud_radius = 1.;
+            },
+            Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size"),
+          "Cloud size 6 with the search radius 2 h (edge cones hold 4 points) rejected naming Absorbing "
+          "boundary/Cloud size");
+    check(!rejected([](E13 &c) { c.abc.cloud_size = 4; }, Fem::WaveBoundary::absorbing, "Cloud size"),
+          "Cloud size 4 accepted");
+    {
+      // The entries parse into the struct.
+      ParameterHandler prm;
+      Abc::WaveAbcParameters::declare_parameters(prm);
+      prm.set("Cloud size", "2");
+      prm.set("Cloud size rule", "normal line");
+      Abc::WaveAbcParameters p;
+      p.parse_parameters(prm);
+      check(p.cloud_size == 2 && p.cloud_size_rule == "normal line", "Cloud size and Cloud size rule parsed");
+    }
+    check(rejected(
+            [](E13 &c) {
+              c.abc.cloud_size      = 2;
+              c.abc.cloud_size_rule = "farthest";
+            },
+            Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size rule"),
+          "unknown Cloud size rule rejected naming Absorbing boundary/Cloud size rule");
     // Curved modes need the centre x_i - rho n outside the cloud (the
     // default cloud radius 2 h = 1).
     check(rejected([](E13 &c) { c.abc.curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing, "Curvature radius"),
@@ -943,8 +978,8 @@ namespace
   // (e13_default) with the EBF keys of with_wave_settings, plus L, T, dt,
   // newmark=1, rho=1 (one-step spectral radius on (-3, 3)^2, h = 0.5) or
   // rhoonly=1, where=n (the n largest field errors at t_end and the max
-  // error per ring along the boundary) and lref (half width of the extended
-  // reference).
+  // error per ring along the boundary), lref (half width of the extended
+  // reference) and csize (Cloud size, session 19), crule (nearest|normal: Cloud size rule).
   void
   e13_scan()
   {
@@ -957,6 +992,9 @@ namespace
         const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv.at(k)) : def; };
         E13        c   = e13_default();
         c.abc          = with_wave_settings(c.abc, kv);
+        c.abc.cloud_size = static_cast<unsigned int>(num("csize", c.abc.cloud_size));
+        if (kv.count("crule"))
+          c.abc.cloud_size_rule = kv.at("crule") == "normal" ? "normal line" : kv.at("crule");
         c.L            = num("L", c.L);
         c.t_end        = num("T", c.t_end);
         c.dt           = num("dt", c.dt);

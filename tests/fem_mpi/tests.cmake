@@ -4,7 +4,7 @@ foreach(_t rank_invariance_diffusion rank_invariance_wave)
   perideal_add_test(NAME fem_mpi.${_t}.np2 NPROCS 2 COMMAND $<TARGET_FILE:fem_mpi_tests> ${_t} LABELS mpi)
 endforeach()
 # Disk near fields: diffusion vs the heat kernel, waves vs an extended disk.
-foreach(_t disk_diffusion disk_wave disk_wave_compact)
+foreach(_t disk_diffusion disk_wave disk_wave_compact disk_wave_cloud_size)
   perideal_add_test(NAME fem_mpi.${_t} COMMAND $<TARGET_FILE:fem_mpi_tests> ${_t} LABELS convergence)
 endforeach()
 # 3D FEM diffusion with the EBF ABC (octant frame) on a cube and a ball vs the heat kernel.

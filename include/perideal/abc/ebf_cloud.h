@@ -68,6 +68,27 @@ namespace PeriDEAL
       bin_of(const Point<dim> &p) const;
     };
 
+    /**
+     * The cloud of a fixed size (session 19, "Cloud size"): @p cone[0]
+     * (x_i) and the @p n entries of @p cone nearest to it (distance |x bar|),
+     * plus every further entry at the n-th distance up to 1e-9 @p dx (ties
+     * kept, so that symmetric clouds stay symmetric), sorted by @p ids of
+     * the points. Equivalent to a per-node radius grown until the cloud
+     * holds n points. Throws ParameterError naming "Absorbing
+     * boundary/Cloud size" if the cone holds fewer than n points.
+     * @p along_normal ("Cloud size rule = normal line"): the radius is the
+     * n-th distance among the cone points near the inward normal line
+     * (lateral offset < depth / 2), and every cone point within it is kept.
+     */
+    template <int dim>
+    std::vector<std::pair<unsigned int, Tensor<1, dim>>>
+    nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, dim>>> &cone,
+                         const unsigned int                                          n,
+                         const std::vector<types::global_dof_index>                 &ids,
+                         const double                                                dx,
+                         const double                                                search_radius,
+                         const bool                                                  along_normal = false);
+
     /** Result of one moment-matrix fit. */
     struct PseudoInverseFit
     {

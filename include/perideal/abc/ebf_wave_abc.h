@@ -49,6 +49,22 @@ namespace PeriDEAL
       double cone_angle = M_PI / 4.;
       /** Cloud radius (0: the horizon delta for PD, 2 dx for FEM). */
       double cloud_radius = 0.;
+      /**
+       * Cloud size n (session 19): 0 = every cone point within the cloud
+       * radius (the source); n > 0 = x_i and its n nearest cone points
+       * (points at the same distance as the n-th are kept too), i.e. a
+       * per-node radius grown until the cloud holds n points, so that the
+       * cloud composition does not depend on where a fixed radius falls on
+       * a curved mesh. The cloud radius is then only the search radius (FEM
+       * default 2 n dx).
+       */
+      unsigned int cloud_size = 0;
+      /**
+       * "nearest" (the n nearest cone points) or "normal line" (every cone
+       * point within the distance of the n-th point near the inward normal
+       * line, lateral offset < depth / 2; session 19, exploratory).
+       */
+      std::string cloud_size_rule = "nearest";
       /** PD absorbing layer thickness delta_L (0: the horizon). */
       double layer_thickness = 0.;
       /** "local" (4.39), "nonlocal" (continuum PD, (4.47)/(4.51)/(4.90)) or "discrete" (4.85)/(4.95). */
