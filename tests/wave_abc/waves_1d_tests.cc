@@ -12,9 +12,11 @@
 // Exploration: WAVES_1D_SCAN="key=value ..." (the EBF keys of
 // tests/wave_settings.h, plus for the FEM h, L, dt, T, scheme=verlet|newmark)
 // with the test names pd_scan_b, pd_scan_c, fem_scan; keys rho (one-step
-// spectral radius), vel=1 (FEM Extrapolate velocity), emargin=n (FEM energy
+// spectral radius), vel=1 (FEM Extrapolate velocity), lumped=0|1 (FEM mass),
+// emargin=n (FEM energy
 // without n boundary cells); WAVES_1D_WHERE=dx prints where the PD field
-// error at t_end is (positions scaled by dx).
+// error at t_end is (positions scaled by dx); WAVES_1D_TRACE=1 prints the FEM
+// energy differences at every sample.
 
 #include <deal.II/base/function.h>
 
@@ -398,6 +400,9 @@ namespace
           {
             auto &e  = r[w.first];
             e.energy = std::max(e.energy, std::abs(w.second->energy(inside) - er) / e0);
+            if (std::getenv("WAVES_1D_TRACE") && root())
+              std::cout << "      t " << s * c.dt << " " << w.first << ": (E - E_ref)/E0 "
+                        << sci((w.second->energy(inside) - er) / e0) << ", E_ref/E0 " << sci(er / e0) << std::endl;
             double m = 0.;
             for (unsigned int j = 0; j <= n_nodes; ++j)
               {
@@ -501,6 +506,9 @@ namespace
     c.T            = num("T", c.T);
     c.energy_margin = num("emargin", 0.);
     c.fem.extrapolate_velocity = num("vel", 0.) != 0.;
+    // lumped=1: Newmark with the lumped mass (for the discrete relation).
+    if (kv.count("lumped"))
+      c.fem.lumped_mass = num("lumped", 1.) != 0.;
     double rho     = 0.;
     fem_compare(c, {{"EBF scan", with_wave_settings(c.abc, kv)}}, kv.count("rho") ? &rho : nullptr);
   }
