@@ -380,7 +380,7 @@ namespace PeriDEAL
         double       scale = 0.;
         for (unsigned int q = 1; q <= 64; ++q)
           scale = std::max(scale, std::abs(omega2(kmax * q / 64.)));
-        for (unsigned int J = 1; J <= 16; ++J)
+        for (unsigned int J = 1; J <= 64; ++J)
           {
             Eigen::MatrixXd A(J, J);
             Eigen::VectorXd b(J);
@@ -621,7 +621,7 @@ namespace PeriDEAL
           // frequency of each k_m > 0, exp(i kr x bar - kappa x bar), and
           // the conjugates.
           std::vector<double> kappa(kvec.size(), 0.);
-          if (dim == 1 && prm.evanescent_modes != "none")
+          if (dim == 1 && !lattice.empty())
             {
               for (const bool outward : {true, false})
                 {
