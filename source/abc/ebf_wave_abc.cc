@@ -68,7 +68,8 @@ namespace PeriDEAL
                         "PD absorbing layer delta_L (0: the horizon).");
       prm.declare_entry("Dispersion relation", "discrete",
                         Patterns::Selection("local|nonlocal|discrete"),
-                        "local (4.39), continuum nonlocal (4.47/4.51/4.90) or discrete (4.85/4.95).");
+                        "local (4.39), continuum nonlocal (4.47/4.51/4.90) or discrete (4.85/4.95; FEM Q1: the "
+                        "stiffness row over the lumped mass or the consistent mass row).");
       prm.declare_entry("Maximum condition number", "1e12", Patterns::Double(1.),
                         "Guard on the moment matrices.");
       prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),

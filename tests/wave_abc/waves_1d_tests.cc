@@ -296,6 +296,23 @@ namespace
             std::cout << "    EBF evanescent: one-step spectral radius - 1 = " << sci(rho_e - 1.) << std::endl;
           check(rho_e <= 1. + 1e-8, "E12b evanescent EBF: one-step radius - 1 = " + sci(rho_e - 1.) + " <= 1e-8");
         }
+      {
+        // Bad input: the evanescent roots need a lattice relation (the local
+        // one, omega = chi k, has none).
+        auto bad             = e12b_ebf("local", 4);
+        bad.evanescent_modes = "outgoing";
+        bool thrown          = false;
+        try
+          {
+            pd_run(BoxDomain<1>(Point<1>(-c.L), Point<1>(c.L)), c.lp, c.mp, WaveTruncation::absorbing, bad,
+                   e12b_u0, 0., 0, c.L);
+          }
+        catch (const ParameterError &)
+          {
+            thrown = true;
+          }
+        check(thrown, "E12b: Evanescent modes with the local relation is rejected with a ParameterError");
+      }
       // Outgoing evanescent modes (session 19): measured energy 5.57e-3
       // (6.7x below first order, 8.3x below the source's EBF), field at
       // t_end 3.71e-2 (1.23x below first order, 2.6x below the source's
