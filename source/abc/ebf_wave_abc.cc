@@ -75,7 +75,8 @@ namespace PeriDEAL
                         "PD absorbing layer delta_L (0: the horizon).");
       prm.declare_entry("Dispersion relation", "discrete",
                         Patterns::Selection("local|nonlocal|discrete"),
-                        "local (4.39), continuum nonlocal (4.47/4.51/4.90) or discrete (4.85/4.95).");
+                        "local (4.39), continuum nonlocal (4.47/4.51/4.90) or discrete (4.85/4.95; FEM Q1: the "
+                        "stiffness row over the lumped mass or the consistent mass row).");
       prm.declare_entry("Maximum condition number", "1e12", Patterns::Double(1.),
                         "Guard on the moment matrices.");
       prm.declare_entry("Maximum updating vector norm", "2", Patterns::Double(0.),
@@ -100,6 +101,10 @@ namespace PeriDEAL
                         "Brillouin-zone corner, or corner and face centres.");
       prm.declare_entry("Lattice mode damping", "0", Patterns::Double(0.),
                         "Extra decay rate of the lattice modes.");
+      prm.declare_entry("Evanescent modes", "none", Patterns::Selection("none|outgoing|incoming|all"),
+                        "1D, lattice (discrete) relation: the complex-k roots of Omega^2(k) = Omega^2(k_m) "
+                        "added to the modes: none (the source), outgoing (decaying outward), incoming "
+                        "(decaying inward) or all.");
       prm.declare_entry("Layer filter", "0", Patterns::Double(0., 0.25),
                         "eps of the lattice-Laplacian viscosity added to the updating vectors "
                         "(eps sum over the nearest nodes of (u_j - u_i)^n - (u_j - u_i)^{n-1}; 0: the source).");
@@ -169,6 +174,7 @@ namespace PeriDEAL
       thinning                 = prm.get("Thinning");
       lattice_modes            = prm.get("Lattice modes");
       lattice_mode_damping     = prm.get_double("Lattice mode damping");
+      evanescent_modes         = prm.get("Evanescent modes");
       layer_filter             = prm.get_double("Layer filter");
       fit_form                 = prm.get("Fit form");
       curvature_radius         = prm.get_double("Curvature radius");
@@ -239,17 +245,23 @@ namespace PeriDEAL
     WaveDispersion<dim>::stencil(const std::vector<Tensor<1, dim>> &offsets,
                                  const std::vector<double>         &weights,
                                  const double                       damping,
-                                 const std::string                 &name)
+                                 const std::string                 &name,
+                                 const double                       mass_diagonal,
+                                 const std::vector<Tensor<1, dim>> &mass_offsets,
+                                 const std::vector<double>         &mass_weights)
     {
       AssertDimension(offsets.size(), weights.size());
+      AssertDimension(mass_offsets.size(), mass_weights.size());
       WaveDispersion<dim> w;
       w.name    = name;
       w.damping = damping;
-      w.omega2  = [offsets, weights](const Tensor<1, dim> &k) {
-        double s = 0.;
+      w.omega2  = [offsets, weights, mass_diagonal, mass_offsets, mass_weights](const Tensor<1, dim> &k) {
+        double s = 0., m = mass_diagonal;
         for (unsigned int j = 0; j < offsets.size(); ++j)
           s += weights[j] * (1. - std::cos(k * offsets[j]));
-        return s;
+        for (unsigned int j = 0; j < mass_offsets.size(); ++j)
+          m += mass_weights[j] * std::cos(k * mass_offsets[j]);
+        return s / m;
       };
       return w;
     }
@@ -363,6 +375,82 @@ namespace PeriDEAL
                             std::numeric_limits<double>::infinity();
         f.vmax = Vc.cwiseAbs().maxCoeff();
         return f;
+      }
+
+      /**
+       * 1D lattice relation Omega^2(k) = sum_{j=1}^J a_j (1 - cos(k j dx)):
+       * the coefficients a_j recovered from samples of @p omega2 (the
+       * smallest J <= 16 that reproduces it at off-grid wave numbers to
+       * 1e-10 relative); empty if it is no such trigonometric polynomial.
+       */
+      std::vector<double>
+      lattice_coefficients(const std::function<double(double)> &omega2, const double dx)
+      {
+        const double kmax = M_PI / dx;
+        double       scale = 0.;
+        for (unsigned int q = 1; q <= 64; ++q)
+          scale = std::max(scale, std::abs(omega2(kmax * q / 64.)));
+        for (unsigned int J = 1; J <= 64; ++J)
+          {
+            Eigen::MatrixXd A(J, J);
+            Eigen::VectorXd b(J);
+            for (unsigned int q = 0; q < J; ++q)
+              {
+                const double kq = kmax * (q + 1.) / J;
+                b[q]            = omega2(kq);
+                for (unsigned int j = 0; j < J; ++j)
+                  A(q, j) = 1. - std::cos(kq * (j + 1.) * dx);
+              }
+            const Eigen::VectorXd a  = A.colPivHouseholderQr().solve(b);
+            double                err = 0.;
+            for (const double t : {0.137, 0.291, 0.4433, 0.618, 0.777, 0.9137})
+              {
+                double s = 0.;
+                for (unsigned int j = 0; j < J; ++j)
+                  s += a[j] * (1. - std::cos(t * kmax * (j + 1.) * dx));
+                err = std::max(err, std::abs(s - omega2(t * kmax)));
+              }
+            if (err <= 1e-10 * scale)
+              return std::vector<double>(a.data(), a.data() + J);
+          }
+        return {};
+      }
+
+      /**
+       * The roots z = exp(i k dx) of sum_j a_j (1 - (z^j + z^-j)/2) = W2 off
+       * the unit circle (|z| < 1 - 1e-8 for @p outward, else > 1 + 1e-8), as
+       * complex wave numbers k = -i log(z) / dx.
+       */
+      std::vector<std::complex<double>>
+      evanescent_wave_numbers(const std::vector<double> &a, const double W2, const double dx, const bool outward)
+      {
+        // z^J times the relation: degree 2J polynomial, coefficients c_p of z^p.
+        const unsigned int  J = a.size();
+        std::vector<double> c(2 * J + 1, 0.);
+        c[J] = -W2;
+        for (unsigned int j = 1; j <= J; ++j)
+          {
+            c[J] += a[j - 1];
+            c[J + j] -= 0.5 * a[j - 1];
+            c[J - j] -= 0.5 * a[j - 1];
+          }
+        // Companion matrix of the monic polynomial (leading c_{2J} = -a_J/2 != 0).
+        const unsigned int n = 2 * J;
+        Eigen::MatrixXd    C = Eigen::MatrixXd::Zero(n, n);
+        for (unsigned int p = 1; p < n; ++p)
+          C(p, p - 1) = 1.;
+        for (unsigned int p = 0; p < n; ++p)
+          C(p, n - 1) = -c[p] / c[n];
+        const Eigen::EigenSolver<Eigen::MatrixXd> es(C, false);
+        std::vector<std::complex<double>>         k;
+        for (Eigen::Index p = 0; p < es.eigenvalues().size(); ++p)
+          {
+            const std::complex<double> z = es.eigenvalues()[p];
+            const double               r = std::abs(z);
+            if (outward ? r < 1. - 1e-8 : r > 1. + 1e-8)
+              k.push_back(-std::complex<double>(0., 1.) * std::log(z) / dx);
+          }
+        return k;
       }
     } // namespace
 
@@ -479,6 +567,24 @@ namespace PeriDEAL
       const double chi = std::sqrt(dispersion.symbol(e_long)) / 1e-4;
       check_parameter(prm.method == "ebf" || prm.method == "first order", "Absorbing boundary/Method",
                       prm.method, "ebf or first order");
+      check_parameter(prm.evanescent_modes == "none" || prm.evanescent_modes == "outgoing" ||
+                        prm.evanescent_modes == "incoming" || prm.evanescent_modes == "all",
+                      "Absorbing boundary/Evanescent modes", prm.evanescent_modes, "none, outgoing, incoming or all");
+      std::vector<double> lattice;
+      if (prm.evanescent_modes != "none" && prm.method == "ebf")
+        {
+          check_parameter(dim == 1, "Absorbing boundary/Evanescent modes", prm.evanescent_modes, "none in 2D");
+          lattice = lattice_coefficients(
+            [&dispersion](const double kk) {
+              Tensor<1, dim> kv;
+              kv[0] = kk;
+              return dispersion.symbol(kv);
+            },
+            dx);
+          check_parameter(lattice.size() >= 2, "Absorbing boundary/Evanescent modes", prm.evanescent_modes,
+                          "none unless the dispersion relation is a lattice relation with >= 2 neighbours (" +
+                            dispersion.name + ")");
+        }
       double       max_cond = 0., max_norm = 0.;
       unsigned int min_size = std::numeric_limits<unsigned int>::max(), max_size = 0;
       unsigned int n_thinned = 0, max_stride = 1;
@@ -525,6 +631,36 @@ namespace PeriDEAL
                   decay.push_back(dispersion.damping + prm.lattice_mode_damping);
                 }
             }
+          // Evanescent lattice modes (1D): complex k = kr + i kappa at the
+          // frequency of each k_m > 0, exp(i kr x bar - kappa x bar), and
+          // the conjugates.
+          std::vector<double> kappa(kvec.size(), 0.);
+          if (dim == 1 && !lattice.empty())
+            {
+              for (const bool outward : {true, false})
+                {
+                  if ((outward && prm.evanescent_modes == "incoming") ||
+                      (!outward && prm.evanescent_modes == "outgoing"))
+                    continue;
+                  for (unsigned int m = 0; m < k.size(); ++m)
+                    if (k[m] > 0.)
+                      {
+                        Tensor<1, dim> km;
+                        km[0]                    = k[m];
+                        const std::complex<double> w = dispersion.frequency(k[m], dir_global[0]);
+                        for (const auto &kc : evanescent_wave_numbers(lattice, dispersion.symbol(km), dx, outward))
+                          for (const double sgn : {1., -1.})
+                            {
+                              Tensor<1, dim> kr;
+                              kr[0] = sgn * kc.real();
+                              kvec.push_back(kr);
+                              omega.push_back(sgn > 0. ? w : -std::conj(w));
+                              decay.push_back(dispersion.damping);
+                              kappa.push_back(kc.imag());
+                            }
+                      }
+                }
+            }
           const unsigned int n_all = kvec.size();
           for (unsigned int c = 0; c < n_all; ++c)
             {
@@ -535,6 +671,13 @@ namespace PeriDEAL
               m[dim + 1] = omega[c].imag();
               m[dim + 2] = decay[c];
               node_modes[a].push_back(m);
+              if (kappa[c] != 0.)
+                {
+                  // The class key of store_updating_vectors() must see kappa.
+                  std::array<double, dim + 3> e{};
+                  e[0] = kappa[c];
+                  node_modes[a].push_back(e);
+                }
             }
           // Curved wave fronts (curvature_radius rho > 0, 2D): the local
           // coordinates become s = (r - rho, rho theta) about the centre
@@ -578,7 +721,7 @@ namespace PeriDEAL
                 s[dim - 1]          = rho * std::atan2(from_centre[dim - 1], from_centre[0]);
                 amplitude           = std::sqrt(rho / radius);
               }
-            return amplitude * std::exp(-decay[c] * time + I * (kvec[c] * s) - I * omega[c] * time);
+            return amplitude * std::exp(-decay[c] * time - kappa[c] * s[0] + I * (kvec[c] * s) - I * omega[c] * time);
           };
           const auto mode_rate = [&](const unsigned int c) {
             return -decay[c] - std::complex<double>(0., 1.) * omega[c];

@@ -254,12 +254,13 @@ namespace PeriDEAL
         relation = Abc::WaveDispersion<dim>::local(chi, d);
       else
         {
-          // The semi-discrete symbol of the lumped-mass scheme from the
-          // stiffness row of the DoF nearest the centre (of all ranks). Q2
-          // has vertex, edge and cell DoFs with different rows, the
-          // consistent mass a ratio of two symbols: no single-row symbol.
-          check_parameter(prm.degree == 1 && lumped, "FEM/Degree, FEM/Lumped mass", prm.degree,
-                          "1 with lumped mass for Dispersion relation = discrete (otherwise use local)");
+          // The semi-discrete symbol of the Q1 scheme from the stiffness
+          // row of the DoF nearest the centre (of all ranks), divided by the
+          // lumped mass or by the symbol of the consistent mass row. Q2 has
+          // vertex, edge and cell DoFs with different rows: no single-row
+          // symbol.
+          check_parameter(prm.degree == 1, "FEM/Degree", prm.degree,
+                          "1 for Dispersion relation = discrete (otherwise use local)");
           Point<dim> centre;
           for (unsigned int l = 0; l < near_field.n_owned(); ++l)
             centre += near_field.points[l];
@@ -270,7 +271,11 @@ namespace PeriDEAL
             best = std::min(best, std::make_pair(near_field.points[l].distance(centre), near_field.ids[l]));
           for (const auto &other : Utilities::MPI::all_gather(near_field.comm, best))
             best = std::min(best, other);
-          std::pair<std::vector<Tensor<1, dim>>, std::vector<double>> row;
+          // Stiffness row (offsets, -chi^2 K_ij) and, for the consistent
+          // mass, the mass row (offsets, M_ij) and M_ii; lumped: the row
+          // divided by the lumped mass, mass symbol 1.
+          using Row = std::pair<std::vector<Tensor<1, dim>>, std::vector<double>>;
+          std::pair<Row, std::pair<Row, double>> rows;
           if (near_field.owned.is_element(best.second))
             {
               const unsigned int c = near_field.partitioner->global_to_local(best.second);
@@ -278,14 +283,31 @@ namespace PeriDEAL
                 if (it->column() != best.second)
                   {
                     const unsigned int j = near_field.partitioner->global_to_local(it->column());
-                    row.first.push_back(near_field.points[j] - near_field.points[c]);
-                    row.second.push_back(-chi * chi * it->value() / mass.local_element(c));
+                    rows.first.first.push_back(near_field.points[j] - near_field.points[c]);
+                    // Lumped: divided here (as before session 19, bitwise).
+                    rows.first.second.push_back(-chi * chi * it->value() /
+                                                (lumped ? mass.local_element(c) : 1.));
                   }
+              rows.second.second = 1.;
+              if (!lumped)
+                {
+                  rows.second.second = mass_matrix.el(best.second, best.second);
+                  for (auto it = mass_matrix.begin(best.second); it != mass_matrix.end(best.second); ++it)
+                    if (it->column() != best.second)
+                      {
+                        const unsigned int j = near_field.partitioner->global_to_local(it->column());
+                        rows.second.first.first.push_back(near_field.points[j] - near_field.points[c]);
+                        rows.second.first.second.push_back(it->value());
+                      }
+                }
             }
-          for (const auto &other : Utilities::MPI::all_gather(near_field.comm, row))
-            if (!other.first.empty())
-              row = other;
-          relation = Abc::WaveDispersion<dim>::stencil(row.first, row.second, d, "discrete Q1 lumped");
+          for (const auto &other : Utilities::MPI::all_gather(near_field.comm, rows))
+            if (!other.first.first.empty())
+              rows = other;
+          relation = Abc::WaveDispersion<dim>::stencil(rows.first.first, rows.first.second, d,
+                                                       lumped ? "discrete Q1 lumped" : "discrete Q1 consistent",
+                                                       rows.second.second, rows.second.first.first,
+                                                       rows.second.first.second);
         }
       abc.reinit(near_field.points, near_field.ids, boundary_dofs, near_field.normals, relation, dt, spacing, ap,
                  near_field.comm);

@@ -130,6 +130,18 @@ namespace PeriDEAL
       /** Extra decay rate of the lattice modes (>= 0: the extrapolation damps them). */
       double lattice_mode_damping = 0.;
       /**
+       * 1D with a lattice (discrete) relation Omega^2(k) = sum_j a_j (1 -
+       * cos(k j dx)): evanescent lattice modes added to the mode set. For
+       * every mode k_m > 0 the other roots z = exp(i k dx) of Omega^2(z) =
+       * Omega^2(k_m) (complex k at the same frequency, 2J roots for J
+       * lattice neighbours, two of them k_m and -k_m) are added with the
+       * mode's frequency and their complex conjugates: "none" (the source),
+       * "outgoing" (|z| < 1: decaying outward, the evanescent part of the
+       * exact discrete transparent condition), "incoming" (|z| > 1:
+       * decaying into the near field) or "all" (doc/design.md, session 19).
+       */
+      std::string evanescent_modes = "none";
+      /**
        * eps of the layer filter: eps sum_j ((u_j - u_i)^n - (u_j - u_i)^{n-1})
        * over the nodes within dx of x_i is added to u_i^{n+1} (and likewise
        * to v), a lattice-Laplacian viscosity folded into V_G, V_H (0: the
@@ -265,11 +277,16 @@ namespace PeriDEAL
                const double damping);
       /**
        * The same with an explicit stencil (offsets xi_j and weights w_j,
-       * Omega^2 = sum_j w_j (1 - cos(k.xi_j))), e.g. a FEM row.
+       * Omega^2 = sum_j w_j (1 - cos(k.xi_j))), e.g. a FEM row. With a mass
+       * stencil (diagonal m_0, offsets eta_j, weights m_j) the symbol is
+       * divided by the mass symbol m_0 + sum_j m_j cos(k.eta_j): the
+       * semi-discrete relation of a consistent-mass FEM row.
        */
       static WaveDispersion
       stencil(const std::vector<Tensor<1, dim>> &offsets, const std::vector<double> &weights,
-              const double damping, const std::string &name);
+              const double damping, const std::string &name,
+              const double mass_diagonal = 1., const std::vector<Tensor<1, dim>> &mass_offsets = {},
+              const std::vector<double> &mass_weights = {});
 
       /** Omega^2 for the wave vector @p k (global frame). */
       double
