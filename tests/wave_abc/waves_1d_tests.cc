@@ -229,14 +229,17 @@ namespace
    * E12b: the source's n_b = 4 settings (wave_abc.pd_1d_modes, both
    * relations), the discrete n_b = 5 with one time level (step-7), and a
    * wide local set (Delta alpha = 3, n_b = 6, found by pd_scan_b) against
-   * first order. Measured (doc/design.md, session 18, waves1d):
+   * first order. Measured (session 19; until then the near field lost
+   * its end node x = L to round-off, see doc/design.md, and the EBF
+   * looked worse than first order):
    *   setting                  energy    u at t_end  u over run  rho - 1
-   *   free                     0.997     0.401       0.813
-   *   first order              3.75e-2   4.57e-2     6.76e-2
-   *   discrete n_b 4 (source)  4.63e-2   9.79e-2     1.13e-1     2.9e-5
-   *   local n_b 4              3.42e-2   8.36e-2     9.79e-2     4.9e-6
-   *   discrete n_b 5, 1 level  5.08e-2   1.20e-1     1.35e-1
-   *   local Delta alpha 3 n_b 6 3.09e-3  2.32e-2     2.85e-2     1.7e-6
+   *   free                     0.997     0.385       0.784
+   *   first order              2.97e-2   4.23e-2     6.51e-2     1.4e-6
+   *   discrete n_b 4 (source)  2.49e-4   1.46e-3     1.46e-3     3.8e-5
+   *   local n_b 4              1.33e-4   4.03e-3     7.30e-3
+   *   discrete n_b 5, 1 level  2.32e-4   4.77e-3     5.57e-3
+   *   local Delta alpha 3 n_b 6 1.47e-4  3.84e-3     7.36e-3     1.1e-6
+   *   source + evanescent      2.28e-3   3.85e-2     4.29e-2     -3.1e-9
    * E12c reduced (source settings): energy 3.27e-5 vs 2.46e-3 (75x), u at
    * t_end 3.46e-4 vs 7.85e-3 (22.7x), over the run 3.46e-4 vs 1.24e-2 (36x).
    */
@@ -265,31 +268,32 @@ namespace
       for (const auto &e : r)
         if (e.first != "free")
           check(e.second.energy < 0.1 * r.at("free").energy, "E12b " + e.first + ": energy 10x closer than the free truncation");
-      // The gap, reported (not asserted: a test must not fail when the EBF
-      // improves): with the source's modes (Delta alpha = pi/2 < the
-      // pulse's band) the EBF is NOT closer than the first-order ABC at
-      // t_end (measured 9.79e-2 vs 4.57e-2).
-      if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-        std::cout << "  E12b gap (reported): the source's n_b = 4 EBF field at t_end " << sci(src.end)
-                  << " vs first order " << sci(f.end) << std::endl;
-      // Wide local modes: energy 12.1x (10x asserted; the runs are
-      // deterministic, the margin covers round-off only), field at t_end
-      // 1.97x (1.5x asserted, 10x NOT reached).
+      // The source's settings: 119x in energy, 29x in the field at t_end,
+      // 45x over the run; asserted 10x (the runs are deterministic; the
+      // smallest margin, 2.9x in the field, is what a regression may eat).
+      check(10. * src.energy < f.energy, "E12b source's EBF: max energy difference 10x below first order (" +
+                                           sci(src.energy) + " vs " + sci(f.energy) + ")");
+      check(10. * src.end < f.end, "E12b source's EBF: field at t_end 10x below first order (" + sci(src.end) +
+                                     " vs " + sci(f.end) + ")");
+      check(10. * src.run < f.run, "E12b source's EBF: field over the run 10x below first order (" +
+                                     sci(src.run) + " vs " + sci(f.run) + ")");
+      // Wide local modes: energy 203x, field at t_end 11x (asserted 10x
+      // and 5x).
       check(10. * w.energy < f.energy, "E12b wide local EBF: max energy difference 10x below first order (" +
                                          sci(w.energy) + " vs " + sci(f.energy) + ")");
-      check(1.5 * w.end < f.end, "E12b wide local EBF: field at t_end 1.5x below first order (" + sci(w.end) +
-                                   " vs " + sci(f.end) + "; 10x NOT reached)");
+      check(5. * w.end < f.end, "E12b wide local EBF: field at t_end 5x below first order (" + sci(w.end) +
+                                  " vs " + sci(f.end) + ")");
       if (Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1)
         {
-          // Weakly unstable (measured 1 + 1.7e-6 per step: 4 % over the
+          // Weakly unstable (measured 1 + 1.1e-6 per step: 3 % over the
           // 25,000 steps); asserted below 1e-5 so that a real blow-up fails.
           const double rho = one_step_radius_pd(BoxDomain<1>(Point<1>(-c.L), Point<1>(c.L)), c.lp, c.mp,
                                                 WaveTruncation::absorbing, wide, e12b_u0);
           if (root())
             std::cout << "    EBF local wide: one-step spectral radius - 1 = " << sci(rho - 1.) << std::endl;
           check(rho < 1. + 1e-5, "E12b wide local EBF: one-step radius - 1 = " + sci(rho - 1.) + " < 1e-5 (NOT <= 1)");
-          // Outgoing evanescent modes: stable (measured 1 - 5.6e-9; the
-          // source's n_b 4 without them 1 + 2.9e-5).
+          // Outgoing evanescent modes: stable (measured 1 - 3.1e-9; the
+          // source's n_b 4 without them 1 + 3.8e-5).
           const double rho_e = one_step_radius_pd(BoxDomain<1>(Point<1>(-c.L), Point<1>(c.L)), c.lp, c.mp,
                                                   WaveTruncation::absorbing, evanescent, e12b_u0);
           if (root())
@@ -313,17 +317,15 @@ namespace
           }
         check(thrown, "E12b: Evanescent modes with the local relation is rejected with a ParameterError");
       }
-      // Outgoing evanescent modes (session 19): measured energy 5.57e-3
-      // (6.7x below first order, 8.3x below the source's EBF), field at
-      // t_end 3.71e-2 (1.23x below first order, 2.6x below the source's
-      // 9.79e-2); asserted 5x / below first order / 2x (10x NOT reached).
+      // Outgoing evanescent modes (session 19): stable but less accurate
+      // than the source's modes alone: energy 2.28e-3 (13x below first
+      // order), field at t_end 3.85e-2 (1.1x); asserted 5x / below first
+      // order. Opt-in.
       const auto &ev = r.at("EBF discrete n_b 4 evanescent");
       check(5. * ev.energy < f.energy, "E12b evanescent EBF: max energy difference 5x below first order (" +
-                                         sci(ev.energy) + " vs " + sci(f.energy) + "; NOT 10x)");
+                                         sci(ev.energy) + " vs " + sci(f.energy) + ")");
       check(ev.end < f.end, "E12b evanescent EBF: field at t_end below first order (" + sci(ev.end) + " vs " +
-                              sci(f.end) + "; 10x NOT reached)");
-      check(2. * ev.end < src.end, "E12b evanescent EBF: field at t_end 2x below the source's EBF (" +
-                                     sci(ev.end) + " vs " + sci(src.end) + ")");
+                              sci(f.end) + ")");
     }
     {
       if (root())
