@@ -246,6 +246,23 @@ namespace PeriDEAL
         if (a == 1 && prm.k2_convention == "local limit")
           K[a] = 1. / M;
       }
+
+    // One pattern for the Poisson matrix and every species Jacobian: the
+    // bonds and regions do not change during a run.
+    const auto &part = *disc.partitioner();
+    sparsity.reinit(part.locally_owned_range(), part.locally_owned_range(),
+                    disc.get_mpi_communicator(), nb.stencil_size + 1);
+    std::vector<types::global_dof_index> cols;
+    for (unsigned int i = 0; i < disc.n_owned(); ++i)
+      {
+        cols.assign(1, part.local_to_global(i));
+        if (disc.region[i] == Discretization<dim>::interior)
+          for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
+            if (disc.region[nb.col[b]] == Discretization<dim>::interior)
+              cols.push_back(part.local_to_global(nb.col[b]));
+        sparsity.add_entries(part.local_to_global(i), cols.begin(), cols.end());
+      }
+    sparsity.compress();
   }
 
   template <int dim>
@@ -310,27 +327,10 @@ namespace PeriDEAL
 
   template <int dim>
   void
-  NnppOperator<dim>::make_sparsity(TrilinosWrappers::SparseMatrix &matrix) const
+  NnppOperator<dim>::reinit_matrix(TrilinosWrappers::SparseMatrix &matrix) const
   {
-    const auto &nb   = disc.neighborhood;
-    const auto &part = *disc.partitioner();
-    TrilinosWrappers::SparsityPattern    sp(part.locally_owned_range(),
-                                         part.locally_owned_range(),
-                                         disc.get_mpi_communicator(),
-                                         nb.stencil_size + 1);
-    std::vector<types::global_dof_index> cols;
-    for (unsigned int i = 0; i < disc.n_owned(); ++i)
-      {
-        cols.clear();
-        cols.push_back(part.local_to_global(i));
-        if (disc.region[i] == Discretization<dim>::interior)
-          for (std::uint64_t b = nb.row_start[i]; b < nb.row_start[i + 1]; ++b)
-            if (disc.region[nb.col[b]] == Discretization<dim>::interior)
-              cols.push_back(part.local_to_global(nb.col[b]));
-        sp.add_entries(part.local_to_global(i), cols.begin(), cols.end());
-      }
-    sp.compress();
-    matrix.reinit(sp);
+    if (matrix.m() != sparsity.n_rows())
+      matrix.reinit(sparsity);
   }
 
   template <int dim>
@@ -338,7 +338,7 @@ namespace PeriDEAL
   NnppOperator<dim>::assemble_poisson(TrilinosWrappers::SparseMatrix &matrix,
                                       const Vector                   *phase) const
   {
-    make_sparsity(matrix);
+    reinit_matrix(matrix);
     const auto                          &nb   = disc.neighborhood;
     const auto                          &part = *disc.partitioner();
     std::vector<types::global_dof_index> cols;
@@ -400,7 +400,7 @@ namespace PeriDEAL
                                                const Vector                   *phase,
                                                const Vector                   *dR) const
   {
-    make_sparsity(matrix);
+    reinit_matrix(matrix);
     const auto  &nb   = disc.neighborhood;
     const auto  &part = *disc.partitioner();
     const double zf   = prm.valence[k] * prm.faraday / (prm.gas_constant * prm.temperature);
@@ -577,7 +577,6 @@ namespace PeriDEAL
     Vector rate, dR, Cn;
     disc.initialize_vector(rate);
     disc.initialize_vector(dR);
-    TrilinosWrappers::SparseMatrix    jacobian;
     TrilinosWrappers::PreconditionAMG amg;
     TrilinosWrappers::MPI::Vector     residual(owned, comm), update(owned, comm);
     for (unsigned int k = 0; k < n_species; ++k)

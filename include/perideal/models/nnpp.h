@@ -5,6 +5,7 @@
 
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
 
 #include <perideal/base/kernel.h>
 #include <perideal/discretization/discretization.h>
@@ -277,9 +278,12 @@ namespace PeriDEAL
       return closed == false || disc.region[j] == Discretization<dim>::interior;
     }
     bool closed;
+    /** Diagonal + interior neighbours of interior rows; built once. */
+    TrilinosWrappers::SparsityPattern sparsity;
 
+    /** Gives @p matrix the pattern unless it has it (every assembly overwrites all entries). */
     void
-    make_sparsity(TrilinosWrappers::SparseMatrix &matrix) const;
+    reinit_matrix(TrilinosWrappers::SparseMatrix &matrix) const;
   };
 
   /**
@@ -362,6 +366,8 @@ namespace PeriDEAL
     bool                                  poisson_valid = false;
     TrilinosWrappers::SparseMatrix        poisson_matrix;
     TrilinosWrappers::PreconditionAMG     poisson_amg;
+    /** The frozen species Jacobian, refilled per step and species. */
+    TrilinosWrappers::SparseMatrix        jacobian;
 
     void
     set_layer(const unsigned int k, Vector &c, const double t) const;
