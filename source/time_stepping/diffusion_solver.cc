@@ -200,25 +200,7 @@ namespace PeriDEAL
                   const std::string   &constants,
                   const std::string   &parameter)
     {
-      std::map<std::string, double> c = expression_constants(dim);
-      for (const auto &entry : Utilities::split_string_list(constants, ','))
-        {
-          const auto kv = Utilities::split_string_list(entry, '=');
-          check_parameter(kv.size() == 2, "Model/Constants", constants,
-                          "a list 'name=value, ...'");
-          c[kv[0]] = Utilities::string_to_double(kv[1]);
-        }
-      try
-        {
-          f.initialize(FunctionParser<dim>::default_variable_names() + ",t", expression, c, true);
-          // Evaluate once so that syntax errors surface here, named.
-          f.value(Point<dim>());
-        }
-      catch (std::exception &e)
-        {
-          throw ParameterError(parameter, expression,
-                               "a muparser expression in x, y, z, t and the constants");
-        }
+      init_expression(f, expression, constants, parameter, "Model/Constants");
     }
   } // namespace
 

@@ -31,24 +31,8 @@ namespace PeriDEAL
                   const std::string &constants,
                   const std::string &parameter)
     {
-      std::map<std::string, double> c = expression_constants(dim);
-      for (const auto &entry : Utilities::split_string_list(constants, ','))
-        {
-          const auto kv = Utilities::split_string_list(entry, '=');
-          check_parameter(kv.size() == 2, "NNPP/Constants", constants, "a list 'name=value, ...'");
-          c[kv[0]] = Utilities::string_to_double(kv[1]);
-        }
       auto f = std::make_unique<FunctionParser<dim>>();
-      try
-        {
-          f->initialize(FunctionParser<dim>::default_variable_names() + ",t", expression, c, true);
-          f->value(Point<dim>()); // syntax errors surface here, named
-        }
-      catch (std::exception &)
-        {
-          throw ParameterError(parameter, expression,
-                               "a muparser expression in x, y, z, t and the constants");
-        }
+      init_expression(*f, expression, constants, parameter, "NNPP/Constants");
       return f;
     }
   } // namespace
