@@ -124,34 +124,9 @@ namespace PeriDEAL
                          const unsigned int                                          n,
                          const std::vector<types::global_dof_index>                 &ids,
                          const double                                                dx,
-                         const double                                                search_radius,
-                         const bool                                                  along_normal)
+                         const double                                                search_radius)
     {
       using Entry = std::pair<unsigned int, Tensor<1, dim>>;
-      if (along_normal)
-        {
-          // The n-th distance among the points near the inward normal line
-          // (lateral offset < depth / 2, 26.6 degrees), then every cone
-          // point within it.
-          std::vector<Entry> line(1, cone[0]);
-          for (unsigned int c = 1; c < cone.size(); ++c)
-            {
-              double lat2 = 0.;
-              for (unsigned int d = 1; d < dim; ++d)
-                lat2 += cone[c].second[d] * cone[c].second[d];
-              if (std::sqrt(lat2) < 0.5 * (-cone[c].second[0]))
-                line.push_back(cone[c]);
-            }
-          const auto   on_line = nearest_cloud_points<dim>(line, n, ids, dx, search_radius, false);
-          double       dn      = 0.;
-          for (const auto &e : on_line)
-            dn = std::max(dn, e.second.norm());
-          std::vector<Entry> out(1, cone[0]);
-          for (unsigned int c = 1; c < cone.size(); ++c)
-            if (cone[c].second.norm() <= dn + 1e-9 * dx)
-              out.push_back(cone[c]);
-          return out;
-        }
       if (cone.size() < n + 1)
         throw ParameterError("Absorbing boundary/Cloud size", std::to_string(n),
                              "1 .. the " + std::to_string(cone.size() - 1) +
@@ -198,13 +173,13 @@ namespace PeriDEAL
 
     template std::vector<std::pair<unsigned int, Tensor<1, 1>>>
     nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 1>>> &, unsigned int,
-                         const std::vector<types::global_dof_index> &, double, double, bool);
+                         const std::vector<types::global_dof_index> &, double, double);
     template std::vector<std::pair<unsigned int, Tensor<1, 2>>>
     nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 2>>> &, unsigned int,
-                         const std::vector<types::global_dof_index> &, double, double, bool);
+                         const std::vector<types::global_dof_index> &, double, double);
     template std::vector<std::pair<unsigned int, Tensor<1, 3>>>
     nearest_cloud_points(const std::vector<std::pair<unsigned int, Tensor<1, 3>>> &, unsigned int,
-                         const std::vector<types::global_dof_index> &, double, double, bool);
+                         const std::vector<types::global_dof_index> &, double, double);
     template class EbfCloudBuilder<1>;
     template class EbfCloudBuilder<2>;
   } // namespace Abc

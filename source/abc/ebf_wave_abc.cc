@@ -68,9 +68,6 @@ namespace PeriDEAL
       prm.declare_entry("Cloud size", "0", Patterns::Integer(0, 50),
                         "n: x_i and its n nearest cone points (ties kept; the cloud radius is then the "
                         "search radius, FEM default 2 n dx); 0: all cone points within the cloud radius.");
-      prm.declare_entry("Cloud size rule", "nearest", Patterns::Selection("nearest|normal line"),
-                        "With a Cloud size n > 0: the n nearest cone points, or every cone point within the "
-                        "distance of the n-th point near the inward normal line (lateral offset < depth / 2).");
       prm.declare_entry("Layer thickness", "0", Patterns::Double(0.),
                         "PD absorbing layer delta_L (0: the horizon).");
       prm.declare_entry("Dispersion relation", "discrete",
@@ -160,7 +157,6 @@ namespace PeriDEAL
       cone_angle           = prm.get_double("Cone angle");
       cloud_radius         = prm.get_double("Cloud radius");
       cloud_size           = prm.get_integer("Cloud size");
-      cloud_size_rule      = prm.get("Cloud size rule");
       layer_thickness      = prm.get_double("Layer thickness");
       dispersion           = prm.get("Dispersion relation");
       max_condition_number = prm.get_double("Maximum condition number");
@@ -478,8 +474,6 @@ namespace PeriDEAL
                       "> 0");
       check_parameter(prm.cloud_size <= 50, "Absorbing boundary/Cloud size", prm.cloud_size,
                       "0 (the cloud radius) or 1 .. 50");
-      check_parameter(prm.cloud_size_rule == "nearest" || prm.cloud_size_rule == "normal line",
-                      "Absorbing boundary/Cloud size rule", prm.cloud_size_rule, "nearest or normal line");
       check_parameter(prm.curvature_radius == 0. || prm.curvature_radius > prm.cloud_radius,
                       "Absorbing boundary/Curvature radius", prm.curvature_radius,
                       "0 or > the cloud radius " + std::to_string(prm.cloud_radius));
@@ -799,7 +793,7 @@ namespace PeriDEAL
 
           // Cloud size n > 0 (session 19): x_i and its n nearest cone points.
           if (prm.cloud_size > 0)
-            cone = nearest_cloud_points<dim>(cone, prm.cloud_size, ids, dx, r, prm.cloud_size_rule == "normal line");
+            cone = nearest_cloud_points<dim>(cone, prm.cloud_size, ids, dx, r);
           std::ostringstream name;
           name << "absorbing node " << ids[i] << " at (" << xi << ")";
           Fit          fg, fh;

@@ -476,18 +476,10 @@ namespace
       ParameterHandler prm;
       Abc::WaveAbcParameters::declare_parameters(prm);
       prm.set("Cloud size", "2");
-      prm.set("Cloud size rule", "normal line");
       Abc::WaveAbcParameters p;
       p.parse_parameters(prm);
-      check(p.cloud_size == 2 && p.cloud_size_rule == "normal line", "Cloud size and Cloud size rule parsed");
+      check(p.cloud_size == 2, "Cloud size parsed");
     }
-    check(rejected(
-            [](E13 &c) {
-              c.abc.cloud_size      = 2;
-              c.abc.cloud_size_rule = "farthest";
-            },
-            Fem::WaveBoundary::absorbing, "Absorbing boundary/Cloud size rule"),
-          "unknown Cloud size rule rejected naming Absorbing boundary/Cloud size rule");
     // Curved modes need the centre x_i - rho n outside the cloud (the
     // default cloud radius 2 h = 1).
     check(rejected([](E13 &c) { c.abc.curvature_radius = 0.5; }, Fem::WaveBoundary::absorbing, "Curvature radius"),
@@ -979,7 +971,7 @@ namespace
   // newmark=1, rho=1 (one-step spectral radius on (-3, 3)^2, h = 0.5) or
   // rhoonly=1, where=n (the n largest field errors at t_end and the max
   // error per ring along the boundary), lref (half width of the extended
-  // reference) and csize (Cloud size, session 19), crule (nearest|normal: Cloud size rule).
+  // reference) and csize (Cloud size, session 19).
   void
   e13_scan()
   {
@@ -993,8 +985,6 @@ namespace
         E13        c   = e13_default();
         c.abc          = with_wave_settings(c.abc, kv);
         c.abc.cloud_size = static_cast<unsigned int>(num("csize", c.abc.cloud_size));
-        if (kv.count("crule"))
-          c.abc.cloud_size_rule = kv.at("crule") == "normal" ? "normal line" : kv.at("crule");
         c.L            = num("L", c.L);
         c.t_end        = num("T", c.t_end);
         c.dt           = num("dt", c.dt);

@@ -1042,7 +1042,7 @@ namespace
   // x0, y0 (pulse centre; diagnostic), series=1 (signed energy errors and
   // max vertex errors, boundary / inside, at every sample), where=1 (error
   // at T by boundary angle and by depth), clouds=1 (the clouds of the
-  // first quadrant), csize (Cloud size, session 19), crule (nearest|normal: Cloud size rule), and
+  // first quadrant), csize (Cloud size, session 19), and
   // rho=R0 (one-step spectral radius on disk(R0, 3 + log2(R0/2)), the
   // boundary spacing of the disk_wave mesh; rholevel: refined more) or
   // rhoonly=1 (no run).
@@ -1058,8 +1058,6 @@ namespace
         const auto num = [&](const std::string &k, const double def) { return kv.count(k) ? std::stod(kv.at(k)) : def; };
         Abc::WaveAbcParameters ap = with_wave_settings(e13_abc("local"), kv);
         ap.cloud_size             = static_cast<unsigned int>(num("csize", ap.cloud_size));
-        if (kv.count("crule"))
-          ap.cloud_size_rule = kv.at("crule") == "normal" ? "normal line" : kv.at("crule");
         if (root())
           std::cout << "[" << run << "]" << std::endl;
         try

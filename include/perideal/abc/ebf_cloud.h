@@ -76,9 +76,6 @@ namespace PeriDEAL
      * the points. Equivalent to a per-node radius grown until the cloud
      * holds n points. Throws ParameterError naming "Absorbing
      * boundary/Cloud size" if the cone holds fewer than n points.
-     * @p along_normal ("Cloud size rule = normal line"): the radius is the
-     * n-th distance among the cone points near the inward normal line
-     * (lateral offset < depth / 2), and every cone point within it is kept.
      */
     template <int dim>
     std::vector<std::pair<unsigned int, Tensor<1, dim>>>
@@ -86,8 +83,7 @@ namespace PeriDEAL
                          const unsigned int                                          n,
                          const std::vector<types::global_dof_index>                 &ids,
                          const double                                                dx,
-                         const double                                                search_radius,
-                         const bool                                                  along_normal = false);
+                         const double                                                search_radius);
 
     /** Result of one moment-matrix fit. */
     struct PseudoInverseFit

@@ -59,12 +59,6 @@ namespace PeriDEAL
        * default 2 n dx).
        */
       unsigned int cloud_size = 0;
-      /**
-       * "nearest" (the n nearest cone points) or "normal line" (every cone
-       * point within the distance of the n-th point near the inward normal
-       * line, lateral offset < depth / 2; session 19, exploratory).
-       */
-      std::string cloud_size_rule = "nearest";
       /** PD absorbing layer thickness delta_L (0: the horizon). */
       double layer_thickness = 0.;
       /** "local" (4.39), "nonlocal" (continuum PD, (4.47)/(4.51)/(4.90)) or "discrete" (4.85)/(4.95). */
