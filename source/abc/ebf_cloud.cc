@@ -151,22 +151,29 @@ namespace PeriDEAL
     }
 
     PseudoInverseFit
-    pseudo_inverse_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance)
+    pseudo_inverse_fit(const Eigen::MatrixXcd &M,
+                       const Eigen::MatrixXcd &psi,
+                       const double            tolerance,
+                       const bool              tikhonov)
     {
       PseudoInverseFit                     f;
       const Eigen::BDCSVD<Eigen::MatrixXcd> svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
       const auto                          &sv  = svd.singularValues();
-      const double                         tol = tolerance > 0. ?
-                                                   tolerance :
-                                                   std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon();
+      const double                         eps = std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon();
+      const double                         tol = tolerance > 0. ? tolerance : eps;
+      const double                         cut = tikhonov ? eps : tol;
       Eigen::Index rank = 0;
-      while (rank < sv.size() && sv[rank] > tol * sv[0])
+      while (rank < sv.size() && sv[rank] > cut * sv[0])
         ++rank;
-      const Eigen::MatrixXcd Vc = ((psi * svd.matrixV().leftCols(rank)) *
-                                   sv.head(rank).cwiseInverse().asDiagonal()) *
-                                  svd.matrixU().leftCols(rank).adjoint();
+      Eigen::VectorXd inverse = sv.head(rank).cwiseInverse();
+      if (tikhonov)
+        for (Eigen::Index q = 0; q < rank; ++q)
+          inverse[q] = sv[q] / (sv[q] * sv[q] + tol * tol * sv[0] * sv[0]);
+      const Eigen::MatrixXcd Vc =
+        ((psi * svd.matrixV().leftCols(rank)) * inverse.asDiagonal()) * svd.matrixU().leftCols(rank).adjoint();
       f.V                = Vc.real();
-      f.condition_number = rank > 0 ? sv[0] / sv[rank - 1] : std::numeric_limits<double>::infinity();
+      f.condition_number = rank > 0 ? sv[0] / (tikhonov ? std::max(sv[rank - 1], tol * sv[0]) : sv[rank - 1]) :
+                                      std::numeric_limits<double>::infinity();
       f.max_norm         = Vc.cwiseAbs().maxCoeff();
       return f;
     }

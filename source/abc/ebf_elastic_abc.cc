@@ -142,41 +142,6 @@ namespace PeriDEAL
       return out;
     }
 
-
-    namespace
-    {
-      /**
-       * V = Psi M^+ as pseudo_inverse_fit() (ebf_cloud.cc), optionally with
-       * the Tikhonov weight sigma/(sigma^2 + lambda^2), lambda = tolerance
-       * sigma_max, instead of the truncation (as the scalar EbfWaveAbc's
-       * fit, doc/design.md session 14; a local copy, ebf_cloud is shared).
-       */
-      PseudoInverseFit
-      elastic_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance,
-                  const bool tikhonov)
-      {
-        if (!tikhonov)
-          return pseudo_inverse_fit(M, psi, tolerance);
-        PseudoInverseFit                      f;
-        const Eigen::BDCSVD<Eigen::MatrixXcd> svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
-        const auto                           &sv  = svd.singularValues();
-        const double cut = std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon();
-        Eigen::Index rank = 0;
-        while (rank < sv.size() && sv[rank] > cut * sv[0])
-          ++rank;
-        Eigen::VectorXd inverse(rank);
-        for (Eigen::Index q = 0; q < rank; ++q)
-          inverse[q] = sv[q] / (sv[q] * sv[q] + tolerance * tolerance * sv[0] * sv[0]);
-        const Eigen::MatrixXcd Vc =
-          ((psi * svd.matrixV().leftCols(rank)) * inverse.asDiagonal()) * svd.matrixU().leftCols(rank).adjoint();
-        f.V                = Vc.real();
-        f.condition_number = rank > 0 ? sv[0] / std::max(sv[rank - 1], tolerance * sv[0]) :
-                                        std::numeric_limits<double>::infinity();
-        f.max_norm         = Vc.cwiseAbs().maxCoeff();
-        return f;
-      }
-    } // namespace
-
     void
     EbfElasticAbc::reinit(const std::vector<Point<2>>                &points,
                           const std::vector<types::global_dof_index> &ids,
@@ -395,8 +360,8 @@ namespace PeriDEAL
                           MH(4 * j + 2 * q + s, c) = rate[c] * MG(4 * j + 2 * q + s, c);
                         }
                 }
-              fg = elastic_fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
-              fh = elastic_fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
+              fg = pseudo_inverse_fit(MG, psi_g, prm.pseudo_inverse_tolerance, tikhonov);
+              fh = pseudo_inverse_fit(MH, psi_h, prm.pseudo_inverse_tolerance, tikhonov);
               if (increment)
                 {
                   // + e_i: cloud[0] = x_i, column 2 p = component p at level n.

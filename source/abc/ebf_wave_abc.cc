@@ -345,31 +345,11 @@ namespace PeriDEAL
       Fit
       fit(const CMatrix &M, const CRow &psi, const double tolerance, const bool tikhonov = false)
       {
-        // One SVD gives both the Moore-Penrose inverse and the condition
-        // number. Without a tolerance, Eigen's default rank threshold
-        // (max(rows, cols) * epsilon relative to sigma_max) is used.
-        Fit                           f;
-        const Eigen::BDCSVD<CMatrix>  svd(M, Eigen::ComputeThinU | Eigen::ComputeThinV);
-        const auto                   &sv  = svd.singularValues();
-        const double                  tol = tolerance > 0. ? tolerance :
-                                                             std::max(M.rows(), M.cols()) *
-                                                               std::numeric_limits<double>::epsilon();
-        const double cut = tikhonov ? std::max(M.rows(), M.cols()) * std::numeric_limits<double>::epsilon() : tol;
-        Eigen::Index rank = 0;
-        while (rank < sv.size() && sv[rank] > cut * sv[0])
-          ++rank;
-        Eigen::VectorXd inverse = sv.head(rank).cwiseInverse();
-        if (tikhonov)
-          for (Eigen::Index q = 0; q < rank; ++q)
-            inverse[q] = sv[q] / (sv[q] * sv[q] + tol * tol * sv[0] * sv[0]);
-        const CRow Vc = ((psi * svd.matrixV().leftCols(rank)) * inverse.asDiagonal()) *
-                        svd.matrixU().leftCols(rank).adjoint();
-        // Conjugate-closed mode sets and real data: V is real (the imaginary
-        // part is round-off).
-        f.V    = Vc.real();
-        f.cond = rank > 0 ? sv[0] / (tikhonov ? std::max(sv[rank - 1], tol * sv[0]) : sv[rank - 1]) :
-                            std::numeric_limits<double>::infinity();
-        f.vmax = Vc.cwiseAbs().maxCoeff();
+        const PseudoInverseFit p = pseudo_inverse_fit(M, CMatrix(psi), tolerance, tikhonov);
+        Fit                    f;
+        f.V    = p.V.row(0);
+        f.cond = p.condition_number;
+        f.vmax = p.max_norm;
         return f;
       }
 

@@ -99,11 +99,17 @@ namespace PeriDEAL
     /**
      * V = Psi M^+ by one SVD of the moment matrix @p M; singular values
      * below @p tolerance sigma_max are dropped (0: Eigen's default
-     * max(rows, cols) epsilon). For a conjugate-closed mode set and real
-     * data V is real up to round-off.
+     * max(rows, cols) epsilon). With @p tikhonov the weights are
+     * sigma/(sigma^2 + lambda^2), lambda = @p tolerance sigma_max, instead
+     * (only round-off singular values dropped), and the condition number is
+     * sigma_max / max(sigma_min, lambda). For a conjugate-closed mode set and
+     * real data V is real up to round-off.
      */
     PseudoInverseFit
-    pseudo_inverse_fit(const Eigen::MatrixXcd &M, const Eigen::MatrixXcd &psi, const double tolerance);
+    pseudo_inverse_fit(const Eigen::MatrixXcd &M,
+                       const Eigen::MatrixXcd &psi,
+                       const double            tolerance,
+                       const bool              tikhonov = false);
   } // namespace Abc
 } // namespace PeriDEAL
 
