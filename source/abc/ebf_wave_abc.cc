@@ -98,10 +98,9 @@ namespace PeriDEAL
                         "Brillouin-zone corner, or corner and face centres.");
       prm.declare_entry("Lattice mode damping", "0", Patterns::Double(0.),
                         "Extra decay rate of the lattice modes.");
-      prm.declare_entry("Evanescent modes", "none", Patterns::Selection("none|outgoing|incoming|all"),
+      prm.declare_entry("Evanescent modes", "none", Patterns::Selection("none|outgoing"),
                         "1D, lattice (discrete) relation: the complex-k roots of Omega^2(k) = Omega^2(k_m) "
-                        "added to the modes: none (the source), outgoing (decaying outward), incoming "
-                        "(decaying inward) or all.");
+                        "decaying outward added to the modes (outgoing), or none (the source).");
       prm.declare_entry("Layer filter", "0", Patterns::Double(0., 0.25),
                         "eps of the lattice-Laplacian viscosity added to the updating vectors "
                         "(eps sum over the nearest nodes of (u_j - u_i)^n - (u_j - u_i)^{n-1}; 0: the source).");
@@ -393,12 +392,12 @@ namespace PeriDEAL
       }
 
       /**
-       * The roots z = exp(i k dx) of sum_j a_j (1 - (z^j + z^-j)/2) = W2 off
-       * the unit circle (|z| < 1 - 1e-8 for @p outward, else > 1 + 1e-8), as
+       * The roots z = exp(i k dx) of sum_j a_j (1 - (z^j + z^-j)/2) = W2
+       * inside the unit circle (|z| < 1 - 1e-8: decaying outward), as
        * complex wave numbers k = -i log(z) / dx.
        */
       std::vector<std::complex<double>>
-      evanescent_wave_numbers(const std::vector<double> &a, const double W2, const double dx, const bool outward)
+      evanescent_wave_numbers(const std::vector<double> &a, const double W2, const double dx)
       {
         // z^J times the relation: degree 2J polynomial, coefficients c_p of z^p.
         const unsigned int  J = a.size();
@@ -423,7 +422,7 @@ namespace PeriDEAL
           {
             const std::complex<double> z = es.eigenvalues()[p];
             const double               r = std::abs(z);
-            if (outward ? r < 1. - 1e-8 : r > 1. + 1e-8)
+            if (r < 1. - 1e-8)
               k.push_back(-std::complex<double>(0., 1.) * std::log(z) / dx);
           }
         return k;
@@ -541,9 +540,8 @@ namespace PeriDEAL
       const double chi = std::sqrt(dispersion.symbol(e_long)) / 1e-4;
       check_parameter(prm.method == "ebf" || prm.method == "first order", "Absorbing boundary/Method",
                       prm.method, "ebf or first order");
-      check_parameter(prm.evanescent_modes == "none" || prm.evanescent_modes == "outgoing" ||
-                        prm.evanescent_modes == "incoming" || prm.evanescent_modes == "all",
-                      "Absorbing boundary/Evanescent modes", prm.evanescent_modes, "none, outgoing, incoming or all");
+      check_parameter(prm.evanescent_modes == "none" || prm.evanescent_modes == "outgoing",
+                      "Absorbing boundary/Evanescent modes", prm.evanescent_modes, "none or outgoing");
       std::vector<double> lattice;
       if (prm.evanescent_modes != "none" && prm.method == "ebf")
         {
@@ -610,31 +608,23 @@ namespace PeriDEAL
           // the conjugates.
           std::vector<double> kappa(kvec.size(), 0.);
           if (dim == 1 && !lattice.empty())
-            {
-              for (const bool outward : {true, false})
+            for (unsigned int m = 0; m < k.size(); ++m)
+              if (k[m] > 0.)
                 {
-                  if ((outward && prm.evanescent_modes == "incoming") ||
-                      (!outward && prm.evanescent_modes == "outgoing"))
-                    continue;
-                  for (unsigned int m = 0; m < k.size(); ++m)
-                    if (k[m] > 0.)
+                  Tensor<1, dim> km;
+                  km[0] = k[m];
+                  const std::complex<double> w = dispersion.frequency(k[m], dir_global[0]);
+                  for (const auto &kc : evanescent_wave_numbers(lattice, dispersion.symbol(km), dx))
+                    for (const double sgn : {1., -1.})
                       {
-                        Tensor<1, dim> km;
-                        km[0]                    = k[m];
-                        const std::complex<double> w = dispersion.frequency(k[m], dir_global[0]);
-                        for (const auto &kc : evanescent_wave_numbers(lattice, dispersion.symbol(km), dx, outward))
-                          for (const double sgn : {1., -1.})
-                            {
-                              Tensor<1, dim> kr;
-                              kr[0] = sgn * kc.real();
-                              kvec.push_back(kr);
-                              omega.push_back(sgn > 0. ? w : -std::conj(w));
-                              decay.push_back(dispersion.damping);
-                              kappa.push_back(kc.imag());
-                            }
+                        Tensor<1, dim> kr;
+                        kr[0] = sgn * kc.real();
+                        kvec.push_back(kr);
+                        omega.push_back(sgn > 0. ? w : -std::conj(w));
+                        decay.push_back(dispersion.damping);
+                        kappa.push_back(kc.imag());
                       }
                 }
-            }
           const unsigned int n_all = kvec.size();
           for (unsigned int c = 0; c < n_all; ++c)
             {

@@ -13,7 +13,7 @@
 // tests/wave_settings.h, plus for the FEM h, L, dt, T, scheme=verlet|newmark)
 // with the test names pd_scan_b, pd_scan_c, fem_scan; keys rho (one-step
 // spectral radius), vel=1 (FEM Extrapolate velocity), lumped=0|1 (FEM mass),
-// evan=outgoing|incoming|all (PD: Evanescent modes), emargin=n (FEM energy
+// evan=outgoing (PD: Evanescent modes), emargin=n (FEM energy
 // without n boundary cells); WAVES_1D_WHERE=dx prints where the PD field
 // error at t_end is (positions scaled by dx); WAVES_1D_TRACE=1 prints the FEM
 // energy differences at every sample.

@@ -131,8 +131,7 @@ namespace PeriDEAL
        * lattice neighbours, two of them k_m and -k_m) are added with the
        * mode's frequency and their complex conjugates: "none" (the source),
        * "outgoing" (|z| < 1: decaying outward, the evanescent part of the
-       * exact discrete transparent condition), "incoming" (|z| > 1:
-       * decaying into the near field) or "all" (doc/design.md, session 19).
+       * exact discrete transparent condition; doc/design.md, session 19).
        */
       std::string evanescent_modes = "none";
       /**
